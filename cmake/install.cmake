@@ -1,0 +1,22 @@
+# Install headers under include/mppi/<folder>/, the libraries, the data files and an exported
+# package so that an out-of-tree project can do find_package(mppi) and link mppi::core etc.
+include(CMakePackageConfigHelpers)
+
+foreach(folder IN ITEMS mppi dynamics costs sim)
+  install(DIRECTORY ${PROJECT_SOURCE_DIR}/${folder}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/${folder}
+          FILES_MATCHING PATTERN "*.hpp")
+endforeach()
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/data/ DESTINATION ${CMAKE_INSTALL_DATADIR}/mppi/data)
+
+install(TARGETS mppi_core mppi_io mppi_sim mppi_warnings EXPORT mppiTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+install(EXPORT mppiTargets NAMESPACE mppi:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/mppi)
+
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/mppiConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/mppiConfig.cmake INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/mppi)
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/mppiConfigVersion.cmake
+  VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/mppiConfig.cmake ${PROJECT_BINARY_DIR}/mppiConfigVersion.cmake
+        DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/mppi)

@@ -1,0 +1,278 @@
+#pragma once
+// The MPPI controller (the paper's sidebar "Model Predictive Path Integral Control"):
+//   V_k = clamp(U + eps_k),  eps_k ~ N(0, Sigma) per channel and time step
+//   S_k = rollout cost of V_k + gamma * sum_t u_t^T Sigma^-1 (V_k,t - u_t)
+//   w_k = exp(-(S_k - min S) / lambda) / eta,  U <- sum_k w_k V_k  (then optional smoothing)
+// repeated `iterations` times per step; the first control is returned and U shifted one step
+// (warm start). Buffers are allocated once in the constructor; step() allocates nothing.
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "mppi/backend.hpp"
+#include "mppi/controller_options.hpp"
+#include "mppi/cpu_backend.hpp"
+#include "mppi/error.hpp"
+#include "mppi/multiversion.hpp"
+#include "mppi/noise.hpp"
+#include "mppi/savitzky_golay.hpp"
+
+namespace mppi {
+
+enum class StepStatus {
+  kOk = 0,
+  kInvalidState,     // the start state had a NaN/inf: safe control returned, plan kept
+  kNoValidRollout,   // every sampled cost was NaN/inf: safe control returned
+};
+
+struct StepSummary {
+  StepStatus status = StepStatus::kOk;
+  const char* reason = "";           // human-readable, static storage
+  float min_cost = 0.f;              // best sampled total cost (last iteration)
+  float mean_cost = 0.f;             // mean of the finite sampled costs (last iteration)
+  float effective_sample_size = 0.f; // 1 / sum w^2 (last iteration), in [1, K]
+  int valid_samples = 0;             // samples with a finite cost (last iteration)
+  int iterations = 0;                // iterations run
+  double optimizer_ms = 0.0;         // wall time of step()
+};
+
+namespace detail {
+// Draws V = clamp(U + std * n) for samples [k0, k0 + kChunk) and every t; control cost per lane.
+MPPI_MULTIVERSION inline void sample_chunk(const NoiseKey& key, std::uint32_t iteration, int k0,
+                                           int num_samples, int padded, int horizon, int nu,
+                                           const float* nominal, const float* noise_std,
+                                           const float* lo, const float* hi, float gamma,
+                                           float* controls, float* control_cost) noexcept {
+  constexpr int W = kChunk;
+  float normals[4 * W];
+  float acc[W] = {};
+  const float valid_lanes = static_cast<float>(num_samples - k0);  // lanes j >= this get no noise
+  for (int t = 0; t < horizon; ++t) {
+    for (int block = 0; block * 4 < nu; ++block) {
+      normal_block<W>(key, iteration, static_cast<std::uint32_t>(k0), static_cast<std::uint32_t>(t),
+                      static_cast<std::uint32_t>(block), normals);
+      for (int c = block * 4; c < std::min(nu, block * 4 + 4); ++c) {
+        const float u = nominal[t * nu + c];
+        const float sd = noise_std[c];
+        const float inv_var = 1.f / (sd * sd);
+        const float* n = normals + (c - block * 4) * W;
+        float* v = controls + (static_cast<std::size_t>(t) * nu + c) * padded + k0;
+        MPPI_SIMD_LOOP
+        for (int j = 0; j < W; ++j) {
+          const float on = static_cast<float>(j) < valid_lanes ? 1.f : 0.f;
+          const float vj = clampf(u + on * sd * n[j], lo[c], hi[c]);
+          v[j] = vj;
+          acc[j] += gamma * u * inv_var * (vj - u);
+        }
+      }
+    }
+  }
+  std::copy_n(acc, W, control_cost + k0);
+}
+}  // namespace detail
+
+class Controller {
+ public:
+  // Takes any backend; throws mppi::Error if the options are invalid for it.
+  Controller(std::unique_ptr<Backend> backend, ControllerOptions options)
+      : backend_(std::move(backend)), options_(std::move(options)) {
+    if (!backend_) throw Error("Controller: no backend");
+    const RolloutShape& s = backend_->shape();
+    std::string why;
+    if (!options_.is_valid(s.num_controls, &why)) throw Error("ControllerOptions: " + why);
+    if (s.num_samples != options_.num_samples || s.horizon != options_.horizon)
+      throw Error("Controller: backend shape (K, T) does not match the options");
+    nu_ = s.num_controls;
+    nx_ = s.num_states;
+    padded_ = s.padded_samples;
+    threads_ = options_.num_threads > 0 ? options_.num_threads : omp_get_max_threads();
+    nominal_.assign(static_cast<std::size_t>(options_.horizon) * nu_, 0.f);
+    next_.assign(nominal_.size(), 0.f);
+    controls_.assign(nominal_.size() * padded_, 0.f);
+    costs_.assign(padded_, 0.f);
+    control_costs_.assign(padded_, 0.f);
+    weights_.assign(padded_, 0.f);
+    output_.assign(nu_, 0.f);
+    x0_.assign(nx_, 0.f);
+    if (options_.smoothing_window > 0)
+      smoother_ = SavitzkyGolay(options_.horizon, options_.smoothing_window, options_.smoothing_order);
+    reset();
+  }
+
+  // One control step from the full model state x0 (num_states floats). Returns the control to
+  // apply now (num_controls floats, valid until the next call). Never returns NaN.
+  std::span<const float> step(std::span<const float> x0, StepSummary* summary = nullptr) {
+    const auto start = std::chrono::steady_clock::now();
+    StepSummary local;
+    StepSummary& sum = summary ? *summary : local;
+    sum = StepSummary{};
+    bool finite = x0.size() == static_cast<std::size_t>(nx_);
+    for (std::size_t i = 0; finite && i < x0.size(); ++i) finite = std::isfinite(x0[i]);
+    if (!finite) {
+      sum.status = StepStatus::kInvalidState;
+      sum.reason = x0.size() != static_cast<std::size_t>(nx_) ? "state has the wrong size"
+                                                               : "state contains NaN or inf";
+      return safe_output(sum, start);
+    }
+    std::copy(x0.begin(), x0.end(), x0_.begin());
+    for (int it = 0; it < options_.iterations; ++it) {
+      const auto iteration = static_cast<std::uint32_t>(step_index_ * options_.iterations + it);
+      sample(iteration);
+      backend_->rollout(x0_, controls_, costs_);
+      if (!update_nominal(sum)) return safe_output(sum, start);
+      sum.iterations = it + 1;
+    }
+    std::copy_n(nominal_.begin(), nu_, output_.begin());
+    shift_nominal();
+    ++step_index_;
+    sum.optimizer_ms = elapsed_ms(start);
+    return output_;
+  }
+
+  // Forget the plan: nominal = zero controls clamped to the limits.
+  void reset() {
+    for (int t = 0; t < options_.horizon; ++t)
+      for (int c = 0; c < nu_; ++c)
+        nominal_[t * nu_ + c] = std::clamp(0.f, options_.control_min[c], options_.control_max[c]);
+    step_index_ = 0;
+  }
+
+  std::span<const float> nominal() const { return nominal_; }  // T x nu, row-major
+  // The sampled sequences and costs of the last iteration (T x nu x padded; padded).
+  std::span<const float> sampled_controls() const { return controls_; }
+  std::span<const float> sampled_costs() const { return std::span(costs_).first(options_.num_samples); }
+  std::span<const float> weights() const { return std::span(weights_).first(options_.num_samples); }
+  const ControllerOptions& options() const { return options_; }
+  Backend& backend() { return *backend_; }
+  std::uint64_t step_index() const { return step_index_; }
+
+ private:
+  void sample(std::uint32_t iteration) {
+    const NoiseKey key{options_.seed};
+    const int chunks = padded_ / kChunk;
+    const float gamma = options_.gamma;
+#pragma omp parallel for schedule(static) num_threads(threads_)
+    for (int chunk = 0; chunk < chunks; ++chunk)
+      detail::sample_chunk(key, iteration, chunk * kChunk, options_.num_samples, padded_,
+                           options_.horizon, nu_, nominal_.data(), options_.noise_std.data(),
+                           options_.control_min.data(), options_.control_max.data(), gamma,
+                           controls_.data(), control_costs_.data());
+  }
+
+  // Exponential weights and the weighted average. False if no sample has a finite cost.
+  bool update_nominal(StepSummary& sum) {
+    const int k_count = options_.num_samples;
+    float min_cost = std::numeric_limits<float>::infinity();
+    int valid = 0;
+    double cost_sum = 0.0;
+    for (int k = 0; k < k_count; ++k) {
+      const float s = costs_[k] + control_costs_[k];
+      costs_[k] = s;
+      if (std::isfinite(s)) {
+        min_cost = std::min(min_cost, s);
+        cost_sum += s;
+        ++valid;
+      }
+    }
+    sum.valid_samples = valid;
+    if (valid == 0) {
+      sum.status = StepStatus::kNoValidRollout;
+      sum.reason = "every sampled rollout cost was NaN or infinite";
+      return false;
+    }
+    const float inv_lambda = 1.f / options_.lambda;
+    double eta = 0.0;
+    for (int k = 0; k < k_count; ++k) {
+      const float s = costs_[k];
+      const float w = std::isfinite(s) ? std::exp(-(s - min_cost) * inv_lambda) : 0.f;
+      weights_[k] = w;
+      eta += w;
+    }
+    double sum_sq = 0.0;
+    const auto inv_eta = static_cast<float>(1.0 / eta);  // eta >= 1: the best sample has w = 1
+    for (int k = 0; k < k_count; ++k) {
+      weights_[k] *= inv_eta;
+      sum_sq += static_cast<double>(weights_[k]) * weights_[k];
+    }
+    sum.min_cost = min_cost;
+    sum.mean_cost = static_cast<float>(cost_sum / valid);
+    sum.effective_sample_size = static_cast<float>(1.0 / sum_sq);
+
+    // U <- sum_k w_k V_k: one row (t, c) per task, summed over k in a fixed order, so the
+    // result does not depend on the thread count.
+    const int rows = options_.horizon * nu_;
+    float* next = next_.data();
+    const float* v = controls_.data();
+    const float* w = weights_.data();
+    const int padded = padded_;
+#pragma omp parallel for schedule(static) num_threads(threads_)
+    for (int row = 0; row < rows; ++row) {
+      const float* vr = v + static_cast<std::size_t>(row) * padded;
+      float acc = 0.f;
+      for (int k = 0; k < k_count; ++k) acc += w[k] * vr[k];
+      next[row] = acc;
+    }
+    if (smoother_.enabled()) {
+      for (int c = 0; c < nu_; ++c) smoother_.apply(next_.data() + c, nominal_.data() + c, nu_);
+      for (int t = 0; t < options_.horizon; ++t)
+        for (int c = 0; c < nu_; ++c)
+          nominal_[t * nu_ + c] = std::clamp(nominal_[t * nu_ + c], options_.control_min[c],
+                                             options_.control_max[c]);
+    } else {
+      std::copy(next_.begin(), next_.end(), nominal_.begin());
+    }
+    return true;
+  }
+
+  void shift_nominal() {
+    std::copy(nominal_.begin() + nu_, nominal_.end(), nominal_.begin());
+    // the last step keeps its previous value (the tail of the plan repeats)
+  }
+
+  std::span<const float> safe_output(StepSummary& sum,
+                                     std::chrono::steady_clock::time_point start) {
+    std::copy(options_.safe_control.begin(), options_.safe_control.end(), output_.begin());
+    sum.optimizer_ms = elapsed_ms(start);
+    return output_;
+  }
+
+  static double elapsed_ms(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+        .count();
+  }
+
+  std::unique_ptr<Backend> backend_;
+  ControllerOptions options_;
+  int nu_ = 0, nx_ = 0, padded_ = 0, threads_ = 1;
+  std::uint64_t step_index_ = 0;
+  std::vector<float> nominal_;        // T x nu
+  std::vector<float> next_;           // T x nu, the unsmoothed update
+  std::vector<float> controls_;       // T x nu x padded
+  std::vector<float> costs_;          // padded
+  std::vector<float> control_costs_;  // padded
+  std::vector<float> weights_;        // padded
+  std::vector<float> output_;         // nu
+  std::vector<float> x0_;             // nx
+  SavitzkyGolay smoother_;
+};
+
+// A controller on the CPU backend for model D and cost C.
+template <Dynamics D, StageCost<D> C>
+Controller make_cpu_controller(D model, C cost, const ControllerOptions& options) {
+  std::string why;
+  if (!options.is_valid(D::kNu, &why)) throw Error("ControllerOptions: " + why);
+  auto backend = std::make_unique<CpuBackend<D, C>>(std::move(model), std::move(cost),
+                                                    options.num_samples, options.horizon,
+                                                    options.dt_s, options.num_threads);
+  return Controller(std::move(backend), options);
+}
+
+}  // namespace mppi

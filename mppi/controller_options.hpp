@@ -1,0 +1,64 @@
+#pragma once
+// Settings of the MPPI controller. Defaults are AutoRally's (K = 1920, T = 100, 50 Hz,
+// noise std 0.275 steering / 0.3 throttle, steering +-0.99, throttle [-0.99, 0.65]).
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace mppi {
+
+struct ControllerOptions {
+  int num_samples = 1920;          // K: sampled control sequences per iteration
+  int horizon = 100;               // T: time steps per sequence
+  float dt_s = 0.02f;              // model time step [s] (AutoRally: 1/50 Hz)
+  int iterations = 1;              // optimisation iterations per control step
+  float lambda = 6.0f;             // temperature of the exponential weights [cost units]
+  float gamma = 0.0f;              // weight of the control cost gamma * sum_t u^T Sigma^-1 eps
+  std::vector<float> noise_std = {0.275f, 0.3f};    // per control channel (diagonal Sigma)
+  std::vector<float> control_min = {-0.99f, -0.99f};  // per channel clamp, lower
+  std::vector<float> control_max = {0.99f, 0.65f};    // per channel clamp, upper
+  std::vector<float> safe_control = {0.f, -0.5f};     // output when the state is unusable
+  int smoothing_window = 0;        // Savitzky-Golay window (odd, >= 3); 0 = no smoothing
+  int smoothing_order = 2;         // Savitzky-Golay polynomial order (< window)
+  std::uint64_t seed = 1;          // noise seed (draws depend on seed, step, sample, t, channel)
+  int num_threads = 0;             // CPU threads; 0 = OpenMP default
+
+  // Checks against a model with `num_controls` channels; on failure writes why.
+  bool is_valid(int num_controls, std::string* why) const {
+    auto fail = [&](const std::string& msg) {
+      if (why) *why = msg;
+      return false;
+    };
+    if (num_samples < 1) return fail("num_samples must be >= 1, got " + std::to_string(num_samples));
+    if (horizon < 1) return fail("horizon must be >= 1, got " + std::to_string(horizon));
+    if (!(dt_s > 0.f) || !std::isfinite(dt_s)) return fail("dt_s must be > 0");
+    if (iterations < 1) return fail("iterations must be >= 1");
+    if (!(lambda > 0.f) || !std::isfinite(lambda)) return fail("lambda must be > 0 and finite");
+    if (!(gamma >= 0.f) || !std::isfinite(gamma)) return fail("gamma must be >= 0 and finite");
+    const auto n = static_cast<std::size_t>(num_controls);
+    if (noise_std.size() != n || control_min.size() != n || control_max.size() != n ||
+        safe_control.size() != n)
+      return fail("noise_std, control_min, control_max and safe_control need " +
+                  std::to_string(num_controls) + " entries (one per control channel)");
+    for (std::size_t c = 0; c < n; ++c) {
+      if (!(noise_std[c] > 0.f) || !std::isfinite(noise_std[c]))
+        return fail("noise_std[" + std::to_string(c) + "] must be > 0 and finite");
+      if (!(control_min[c] < control_max[c]))
+        return fail("control_min[" + std::to_string(c) + "] must be < control_max");
+      if (!(safe_control[c] >= control_min[c] && safe_control[c] <= control_max[c]))
+        return fail("safe_control[" + std::to_string(c) + "] must lie within the control limits");
+    }
+    if (smoothing_window != 0) {
+      if (smoothing_window < 3 || smoothing_window % 2 == 0)
+        return fail("smoothing_window must be 0 or an odd number >= 3");
+      if (smoothing_order < 0 || smoothing_order >= smoothing_window)
+        return fail("smoothing_order must be in [0, smoothing_window)");
+      if (smoothing_window > horizon) return fail("smoothing_window must be <= horizon");
+    }
+    if (num_threads < 0) return fail("num_threads must be >= 0");
+    return true;
+  }
+};
+
+}  // namespace mppi

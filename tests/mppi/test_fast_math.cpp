@@ -1,0 +1,27 @@
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "mppi/fast_math.hpp"
+
+TEST_CASE("fast_tanh, fast_log and fast_sincos_turns against libm", "[core][math]") {
+  double tanh_err = 0, log_err = 0, trig_err = 0;
+  for (int i = -200000; i <= 200000; ++i) {
+    const float x = i * 1e-4f;  // [-20, 20]
+    tanh_err = std::max(tanh_err, std::abs(mppi::fast_tanh(x) - std::tanh(double(x))));
+  }
+  for (int i = 1; i < (1 << 24); i += 97) {
+    const float u = (i + 0.5f) / 16777216.f;
+    log_err = std::max(log_err, std::abs(mppi::fast_log(u) - std::log(double(u))) /
+                                    std::max(1.0, std::abs(std::log(double(u)))));
+    float s, c;
+    mppi::fast_sincos_turns(u, &s, &c);
+    trig_err = std::max(trig_err, std::abs(s - std::sin(2 * M_PI * u)));
+    trig_err = std::max(trig_err, std::abs(c - std::cos(2 * M_PI * u)));
+  }
+  CHECK(tanh_err < 1e-6);
+  CHECK(log_err < 1e-6);
+  CHECK(trig_err < 1e-6);
+  CHECK(mppi::fast_log(1e-30f) == Approx(std::log(1e-30)).epsilon(1e-6));
+  CHECK(mppi::fast_tanh(1e30f) == 1.0f);
+  CHECK(mppi::fast_tanh(-INFINITY) == -1.0f);
+}
