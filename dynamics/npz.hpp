@@ -1,7 +1,9 @@
 #pragma once
 // Reader for NumPy .npz archives (zip of .npy files, stored or deflated), through libzip.
-// Supports little-endian float32 / float64 arrays in C order (what AutoRally ships);
-// everything else is rejected with an mppi::Error naming the file and the array.
+// Supports little-endian float32 / float64 arrays in C order (what AutoRally ships), and for
+// convenience int32 / int64 / uint8 / bool (converted to double: int64 beyond 2^53 rounds);
+// everything else (big-endian, complex, structured, Fortran order) is rejected with an
+// mppi::Error naming the file and the array. Members not named "*.npy" are skipped.
 #include <cstddef>
 #include <map>
 #include <string>
@@ -12,6 +14,7 @@ namespace mppi {
 struct NpyArray {
   std::vector<std::size_t> shape;  // e.g. {32, 6}; {} for a 0-d scalar
   std::vector<double> values;      // C order, converted to double whatever the stored dtype
+  std::string dtype;               // the stored numpy dtype, e.g. "<f8", "<f4"
   std::size_t size() const { return values.size(); }
 };
 

@@ -1,0 +1,317 @@
+// mppi-bench: what one MPPI control step with the AutoRally network costs on this CPU, how far
+// it is from the bare limit of the network's arithmetic, and which part dominates.
+//
+//   BM_MppiIteration/threads:N   one controller.step(x0): sampling + rollouts + weights + update
+//                                (AutoRally network, AutoRallyCost on the Gazebo cost map,
+//                                K = 1920, T = 100, 1 iteration)
+//   BM_BareLimit/threads:N       the network alone over the same K x T, hand-tuned (bare_limit.hpp)
+//   BM_NoiseSampling/threads:N   drawing the K x T x 2 clamped perturbed controls
+//   BM_NetworkRollout/threads:N  backend rollout, network + kinematics, cost = 0
+//   BM_Rollout/threads:N         backend rollout, network + AutoRallyCost (what step() runs)
+//   BM_CostMapLookup/threads:N   K x T cost-map lookups (bilinear/nearest as the cost does it)
+// N is the OpenMP thread count. Times are wall-clock (UseRealTime). items = K*T rollout steps.
+// Standard Google Benchmark flags: --benchmark_format=json, --benchmark_out=FILE,
+// --benchmark_repetitions=N, --benchmark_filter=REGEX. The JSON context has the CPU (Google
+// Benchmark's own fields plus cpu_model, dispatch_isa, compiler, flags, omp_max_threads).
+// Before the benchmarks, a one-off check prints (stderr) that the bare kernel matches a naive
+// double-precision reference, and exits 1 if it does not.
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bare_limit.hpp"
+#include "parts.hpp"
+#include "costs/autorally_cost.hpp"
+#include "costs/cost_map.hpp"
+#include "dynamics/autorally_nn.hpp"
+#include "mppi/controller.hpp"
+#include "mppi/cpu_backend.hpp"
+#include "mppi/noise.hpp"
+
+namespace {
+
+constexpr int kSamples = 1920;  // K (AutoRally's)
+constexpr int kHorizon = 100;   // T
+constexpr float kDt = 0.02f;
+
+std::string data_path(const std::string& relative) {
+  return std::string(MPPI_BENCH_DATA_DIR) + "/" + relative;
+}
+const char* const kNetworkFile = "autorally/models/autorally_nnet_09_12_2018.npz";
+const char* const kCostMapFile = "autorally/maps/gazebo/gazebo_costmap.npz";
+
+// On the Gazebo track centreline (channel0 = 0 for 7 m ahead), heading along the straight
+// (north-west, 135 deg) at 5 m/s.
+mppi::VehicleState start_state() {
+  mppi::VehicleState s;
+  s.x_m = -8.5f;
+  s.y_m = -8.9f;
+  s.yaw_rad = 2.3561945f;
+  s.vx_mps = 5.f;
+  return s;
+}
+
+const mppi::AutoRallyNetwork& network() {
+  static const mppi::AutoRallyNetwork net = mppi::AutoRallyNetwork::load(data_path(kNetworkFile));
+  return net;
+}
+const std::shared_ptr<const mppi::CostMap>& cost_map() {
+  static const std::shared_ptr<const mppi::CostMap> map =
+      std::make_shared<const mppi::CostMap>(mppi::CostMap::load_npz(data_path(kCostMapFile)));
+  return map;
+}
+mppi::AutoRallyCost make_cost() { return mppi::AutoRallyCost(cost_map()); }
+
+mppi::ControllerOptions options(int threads) {
+  mppi::ControllerOptions o;  // AutoRally's defaults: K = 1920, T = 100, dt = 0.02, 1 iteration
+  o.num_samples = kSamples;
+  o.horizon = kHorizon;
+  o.dt_s = kDt;
+  o.iterations = 1;
+  o.num_threads = threads;
+  return o;
+}
+
+std::vector<float> model_state(const mppi::AutoRallyNetwork& net, const mppi::VehicleState& s) {
+  std::vector<float> x(mppi::AutoRallyNetwork::kNx, 0.f);
+  net.init_state(s, x.data());
+  return x;
+}
+
+void set_rate_counters(benchmark::State& state, int threads) {
+  const double steps = static_cast<double>(kSamples) * kHorizon;
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * kSamples * kHorizon);
+  state.counters["threads"] = threads;
+  state.counters["K"] = kSamples;
+  state.counters["T"] = kHorizon;
+  // wall time per rollout step (one sample, one time step), all threads together
+  state.counters["time_per_step"] =
+      benchmark::Counter(steps, benchmark::Counter::kIsIterationInvariantRate |
+                                    benchmark::Counter::kInvert);
+}
+
+// A running cost of zero: the rollout is then the network and kinematics only.
+struct ZeroCost {
+  template <int Nx, int Nu, int W>
+  void accumulate(mppi::ConstBatch<Nx, W>, mppi::ConstBatch<Nu, W>, int, float*) const noexcept {}
+};
+
+// Sampled controls as the controller draws them (T x nu x padded), for the rollout benchmarks.
+std::vector<float> sampled_controls(int padded) {
+  const mppi::ControllerOptions o = options(1);
+  const int nu = mppi::AutoRallyNetwork::kNu;
+  std::vector<float> nominal(static_cast<std::size_t>(kHorizon) * nu, 0.f);
+  for (int t = 0; t < kHorizon; ++t) nominal[t * nu + 1] = 0.3f;  // some throttle
+  std::vector<float> controls(nominal.size() * padded), control_cost(padded);
+  for (int k0 = 0; k0 < padded; k0 += mppi::kChunk)
+    mppi::detail::sample_chunk(mppi::NoiseKey{o.seed}, 0, k0, kSamples, padded, kHorizon, nu,
+                               nominal.data(), o.noise_std.data(), o.control_min.data(),
+                               o.control_max.data(), o.gamma, controls.data(), control_cost.data());
+  return controls;
+}
+
+// ---- 1. the full control step ------------------------------------------------------------
+void BM_MppiIteration(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  mppi::Controller controller = mppi::make_cpu_controller(network(), make_cost(), options(threads));
+  const std::vector<float> x0 = model_state(network(), start_state());
+  mppi::StepSummary summary;
+  for (int i = 0; i < 3; ++i) controller.step(x0, &summary);  // warm caches and thread pool
+  for (auto _ : state) {
+    auto u = controller.step(x0, &summary);
+    benchmark::DoNotOptimize(u.data());
+    benchmark::ClobberMemory();
+  }
+  set_rate_counters(state, threads);
+  state.counters["min_cost"] = summary.min_cost;
+  state.counters["ess"] = summary.effective_sample_size;
+  state.counters["valid"] = summary.valid_samples;
+  if (summary.status != mppi::StepStatus::kOk) state.SkipWithError(summary.reason);
+}
+
+// ---- 2. the bare limit ---------------------------------------------------------------------
+const mppi::bench::MlpWeights& mlp_weights() {
+  static const mppi::bench::MlpWeights w = mppi::bench::load_mlp_weights(data_path(kNetworkFile));
+  return w;
+}
+
+void BM_BareLimit(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  mppi::bench::BareLimit bare(mlp_weights(), kSamples, kHorizon, kDt, threads);
+  bare.run();
+  for (auto _ : state) {
+    bare.run();
+    benchmark::ClobberMemory();
+  }
+  set_rate_counters(state, threads);
+  // 6x32 + 32x32 + 32x4 multiply-adds and 64 tanh per rollout step
+  state.counters["GFMA/s"] = benchmark::Counter(
+      1344.0 * kSamples * kHorizon * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["checksum"] = bare.checksum();
+}
+
+// ---- 3. the parts --------------------------------------------------------------------------
+void BM_NoiseSampling(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  const mppi::ControllerOptions o = options(threads);
+  const int nu = mppi::AutoRallyNetwork::kNu;
+  const int padded = mppi::padded_sample_count(kSamples);
+  std::vector<float> nominal(static_cast<std::size_t>(kHorizon) * nu, 0.1f);
+  std::vector<float> controls(nominal.size() * padded), control_cost(padded);
+  std::uint32_t iteration = 0;
+  for (auto _ : state) {
+    // exactly what Controller::sample does
+    const int chunks = padded / mppi::kChunk;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int c = 0; c < chunks; ++c)
+      mppi::detail::sample_chunk(mppi::NoiseKey{o.seed}, iteration, c * mppi::kChunk, kSamples,
+                                 padded, kHorizon, nu, nominal.data(), o.noise_std.data(),
+                                 o.control_min.data(), o.control_max.data(), o.gamma,
+                                 controls.data(), control_cost.data());
+    ++iteration;
+    benchmark::ClobberMemory();
+  }
+  set_rate_counters(state, threads);
+}
+
+template <class Cost>
+void run_rollout(benchmark::State& state, Cost cost) {
+  const int threads = static_cast<int>(state.range(0));
+  mppi::CpuBackend<mppi::AutoRallyNetwork, Cost> backend(network(), std::move(cost), kSamples,
+                                                         kHorizon, kDt, threads);
+  const int padded = backend.shape().padded_samples;
+  const std::vector<float> controls = sampled_controls(padded);
+  const std::vector<float> x0 = model_state(network(), start_state());
+  std::vector<float> costs(padded);
+  backend.rollout(x0, controls, costs);
+  for (auto _ : state) {
+    backend.rollout(x0, controls, costs);
+    benchmark::DoNotOptimize(costs.data());
+    benchmark::ClobberMemory();
+  }
+  set_rate_counters(state, threads);
+}
+void BM_NetworkRollout(benchmark::State& state) { run_rollout(state, ZeroCost{}); }
+void BM_Rollout(benchmark::State& state) { run_rollout(state, make_cost()); }
+
+void BM_CostMapLookup(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  // K x T positions: a fan of trajectories from the start state, like the sampled rollouts'.
+  const int padded = mppi::padded_sample_count(kSamples);
+  std::vector<float> xs(static_cast<std::size_t>(kHorizon) * padded),
+      ys(static_cast<std::size_t>(kHorizon) * padded);
+  const mppi::VehicleState s0 = start_state();
+  for (int k = 0; k < padded; ++k) {
+    const float curvature = -0.4f + 0.8f * static_cast<float>(k % 193) / 192.f;
+    for (int t = 0; t < kHorizon; ++t) {
+      const float dist = s0.vx_mps * kDt * static_cast<float>(t + 1);
+      const float yaw = s0.yaw_rad + curvature * dist;
+      xs[static_cast<std::size_t>(t) * padded + k] = s0.x_m + dist * std::cos(yaw);
+      ys[static_cast<std::size_t>(t) * padded + k] = s0.y_m + dist * std::sin(yaw);
+    }
+  }
+  const mppi::CostMap& map = *cost_map();
+  std::vector<float> acc(padded);
+  for (auto _ : state) {
+    const int chunks = padded / mppi::kChunk;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int c = 0; c < chunks; ++c)
+      mppi::bench::cost_map_chunk(map, xs.data(), ys.data(), padded, kHorizon, c * mppi::kChunk,
+                                  acc.data());
+    benchmark::DoNotOptimize(acc.data());
+    benchmark::ClobberMemory();
+  }
+  set_rate_counters(state, threads);
+}
+
+void thread_args(benchmark::internal::Benchmark* b) {
+  b->ArgName("threads")->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+}
+BENCHMARK(BM_MppiIteration)->Apply(thread_args);
+BENCHMARK(BM_BareLimit)->Apply(thread_args);
+BENCHMARK(BM_NoiseSampling)->Apply(thread_args);
+BENCHMARK(BM_NetworkRollout)->Apply(thread_args);
+BENCHMARK(BM_Rollout)->Apply(thread_args);
+BENCHMARK(BM_CostMapLookup)->Apply(thread_args);
+
+std::string cpu_model() {
+  std::ifstream f("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind("model name", 0) == 0) {
+      const auto colon = line.find(':');
+      return colon == std::string::npos ? line : line.substr(colon + 2);
+    }
+  return "unknown";
+}
+
+// The bare kernel must do the real network arithmetic: compare lanes against a naive
+// double-precision reference after 1 step and after T steps. Returns false on a mismatch.
+bool check_bare_limit(std::string* report) {
+  mppi::bench::BareLimit bare(mlp_weights(), kSamples, kHorizon, kDt, 1);
+  double worst = 0.0;
+  char buf[256];
+  std::string text;
+  for (const int steps : {1, kHorizon}) {
+    bare.run_steps(steps);
+    for (const int k : {0, 1, 17, 63, 64, 777, kSamples - 1}) {
+      const std::vector<double> ref = bare.reference(k, steps);
+      for (int s = 0; s < 4; ++s) {
+        const double err = std::abs(bare.final_state(s, k) - ref[s]) / (1.0 + std::abs(ref[s]));
+        worst = std::max(worst, err);
+      }
+    }
+    std::snprintf(buf, sizeof buf,
+                  "  after %3d steps, lane 777: fast (%.6f, %.6f, %.6f, %.6f) ref (%.6f, %.6f, "
+                  "%.6f, %.6f)\n",
+                  steps, bare.final_state(0, 777), bare.final_state(1, 777),
+                  bare.final_state(2, 777), bare.final_state(3, 777), bare.reference(777, steps)[0],
+                  bare.reference(777, steps)[1], bare.reference(777, steps)[2],
+                  bare.reference(777, steps)[3]);
+    text += buf;
+  }
+  const bool ok = worst < 1e-4;
+  std::snprintf(buf, sizeof buf, "bare-limit check vs naive double reference (7 lanes, 1 and %d steps): "
+                "max rel. error %.2e -> %s\n", kHorizon, worst, ok ? "PASS" : "FAIL");
+  *report = std::string(buf) + text;
+  return ok;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  std::string check;
+  bool ok = false;
+  try {
+    ok = check_bare_limit(&check);
+    network();
+    cost_map();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mppi-bench: %s\n", e.what());
+    return 1;
+  }
+  std::fputs(check.c_str(), stderr);
+  if (!ok) return 1;
+  benchmark::AddCustomContext("cpu_model", cpu_model());
+  benchmark::AddCustomContext("dispatch_isa", mppi::bench::BareLimit::dispatched_isa());
+  benchmark::AddCustomContext("compiler", "GCC " __VERSION__);
+  benchmark::AddCustomContext("cxx_flags", MPPI_BENCH_CXX_FLAGS);
+  benchmark::AddCustomContext("cmake_build_type", MPPI_BENCH_BUILD_TYPE);
+  benchmark::AddCustomContext("omp_max_threads", std::to_string(omp_get_max_threads()));
+  benchmark::AddCustomContext("network", kNetworkFile);
+  benchmark::AddCustomContext("cost_map", kCostMapFile);
+  benchmark::AddCustomContext("K", std::to_string(kSamples));
+  benchmark::AddCustomContext("T", std::to_string(kHorizon));
+  benchmark::AddCustomContext("bare_check", check.substr(0, check.find('\n')));
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,220 @@
+// Cost-map loaders: AutoRally npz, images through OpenCV, AutoRally's track .cfg.
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <optional>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+// OpenCV 4's headers mix enum types, which C++20 deprecates; not our code.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-enum-enum-conversion"
+#include <opencv2/imgcodecs.hpp>
+#pragma GCC diagnostic pop
+
+#include "costs/cost_map.hpp"
+#include "dynamics/npz.hpp"
+#include "mppi/error.hpp"
+
+namespace mppi {
+
+namespace {
+
+float single_value(const NpzFile& npz, const std::string& key) {
+  const NpyArray& a = npz.at(key);
+  if (a.size() != 1)
+    throw Error(npz.path() + ": array '" + key + "' has " + std::to_string(a.size()) +
+                " values, expected 1");
+  return static_cast<float>(a.values[0]);
+}
+
+}  // namespace
+
+CostMap CostMap::load_npz(const std::string& path) {
+  const NpzFile npz = NpzFile::load(path);
+  const NpyArray& xb = npz.at("xBounds", {2});
+  const NpyArray& yb = npz.at("yBounds", {2});
+  const float ppm = single_value(npz, "pixelsPerMeter");
+  const float x_min = static_cast<float>(xb.values[0]), x_max = static_cast<float>(xb.values[1]);
+  const float y_min = static_cast<float>(yb.values[0]), y_max = static_cast<float>(yb.values[1]);
+  int width = 0, height = 0;
+  try {
+    width = pixel_count(x_min, x_max, ppm, "x");
+    height = pixel_count(y_min, y_max, ppm, "y");
+  } catch (const Error& e) {
+    throw Error(path + ": arrays 'xBounds', 'yBounds', 'pixelsPerMeter': " + e.what());
+  }
+  const NpyArray& c0 = npz.at("channel0");
+  const std::size_t expected = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  if (c0.size() != expected)
+    throw Error(path + ": array 'channel0' has " + std::to_string(c0.size()) + " values, expected " +
+                std::to_string(width) + " x " + std::to_string(height) + " = " +
+                std::to_string(expected) + " (from xBounds, yBounds, pixelsPerMeter)");
+  std::vector<float> values(c0.values.begin(), c0.values.end());
+  try {
+    return CostMap(x_min, x_max, y_min, y_max, ppm, std::move(values));
+  } catch (const Error& e) {
+    throw Error(path + ": array 'channel0': " + e.what());
+  }
+}
+
+CostMap CostMap::load_image(const std::string& path, const ImageMapSpec& spec) {
+  int width = 0, height = 0;
+  try {
+    width = pixel_count(spec.x_min_m, spec.x_max_m, spec.pixels_per_meter, "x");
+    height = pixel_count(spec.y_min_m, spec.y_max_m, spec.pixels_per_meter, "y");
+  } catch (const Error& e) {
+    throw Error(path + ": bad ImageMapSpec: " + e.what());
+  }
+  if (!std::isfinite(spec.offset) || !std::isfinite(spec.normalizer) || spec.normalizer == 0.f)
+    throw Error(path + ": bad ImageMapSpec: offset must be finite and normalizer finite and non-zero");
+  const int channel = static_cast<int>(spec.channel);
+  if (channel < 0 || channel > 3) throw Error(path + ": bad ImageMapSpec: channel must be R, G, B or A");
+
+  const cv::Mat img = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (img.empty()) throw Error(path + ": cannot read image (missing file or unsupported format)");
+  if (img.depth() != CV_8U && img.depth() != CV_16U)
+    throw Error(path + ": unsupported image depth (need 8 or 16 bits per channel)");
+  const int n_channels = img.channels();
+  if (n_channels < 1 || n_channels > 4)
+    throw Error(path + ": unsupported number of channels " + std::to_string(n_channels));
+  if (img.cols != width || img.rows != height)
+    throw Error(path + ": image is " + std::to_string(img.cols) + " x " + std::to_string(img.rows) +
+                " pixels, the spec's bounds and pixels_per_meter need " + std::to_string(width) +
+                " x " + std::to_string(height));
+
+  // OpenCV stores colour as BGR(A). -1 = the channel is absent: alpha of an opaque image.
+  int source = -1;
+  if (n_channels >= 3) {
+    const int bgra[4] = {2, 1, 0, 3};  // index of R, G, B, A
+    source = bgra[channel];
+    if (source >= n_channels) source = -1;
+  } else {  // gray (+ alpha): gray counts as R = G = B
+    source = (channel == 3) ? (n_channels == 2 ? 1 : -1) : 0;
+  }
+  const bool is16 = img.depth() == CV_16U;
+  const float opaque = is16 ? 65535.f : 255.f;
+
+  std::vector<float> values(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+  for (int r = 0; r < height; ++r) {
+    const int map_row = spec.row0_is_y_max ? height - 1 - r : r;
+    float* out = values.data() + static_cast<std::size_t>(map_row) * width;
+    for (int c = 0; c < width; ++c) {
+      float raw = opaque;
+      if (source >= 0) {
+        const std::size_t k = static_cast<std::size_t>(c) * n_channels + source;
+        raw = is16 ? static_cast<float>(img.ptr<std::uint16_t>(r)[k])
+                   : static_cast<float>(img.ptr<std::uint8_t>(r)[k]);
+      }
+      out[c] = (raw + spec.offset) / spec.normalizer;  // float, as numpy float32 in track_generator.py
+    }
+  }
+  try {
+    return CostMap(spec.x_min_m, spec.x_max_m, spec.y_min_m, spec.y_max_m, spec.pixels_per_meter,
+                   std::move(values));
+  } catch (const Error& e) {
+    throw Error(path + ": " + e.what());
+  }
+}
+
+namespace {
+
+// The raw text of `"key": value` in a Python-dict file: a [list] or a bare token.
+std::optional<std::string> dict_value(const std::string& text, const std::string& key) {
+  const std::regex re("[\"']" + key + "[\"']\\s*:\\s*(\\[[^\\]]*\\]|[^,}\\s]+)");
+  std::smatch m;
+  if (!std::regex_search(text, m, re)) return std::nullopt;
+  return m[1].str();
+}
+
+std::vector<double> dict_numbers(const std::string& path, const std::string& key, const std::string& raw) {
+  std::string body = raw;
+  if (!body.empty() && body.front() == '[') body = body.substr(1, body.size() - 2);
+  std::vector<double> out;
+  std::stringstream ss(body);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    const auto first = item.find_first_not_of(" \t\r\n");
+    if (first == std::string::npos) continue;  // trailing comma
+    const auto last = item.find_last_not_of(" \t\r\n");
+    const std::string token = item.substr(first, last - first + 1);
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(token, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != token.size() || !std::isfinite(v))
+      throw Error(path + ": key '" + key + "': '" + token + "' is not a finite number");
+    out.push_back(v);
+  }
+  return out;
+}
+
+std::vector<double> required(const std::string& path, const std::string& text, const std::string& key,
+                             std::size_t count) {
+  const auto raw = dict_value(text, key);
+  if (!raw) throw Error(path + ": missing key '" + key + "'");
+  auto v = dict_numbers(path, key, *raw);
+  if (v.size() != count)
+    throw Error(path + ": key '" + key + "' has " + std::to_string(v.size()) + " numbers, expected " +
+                std::to_string(count));
+  return v;
+}
+
+double optional_number(const std::string& path, const std::string& text, const std::string& key,
+                       double fallback) {
+  const auto raw = dict_value(text, key);
+  if (!raw) return fallback;
+  auto v = dict_numbers(path, key, *raw);
+  if (v.size() != 1) throw Error(path + ": key '" + key + "' must be one number");
+  return v[0];
+}
+
+}  // namespace
+
+ImageMapSpec CostMap::read_autorally_track_cfg(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open track config");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+
+  ImageMapSpec spec;
+  const auto xb = required(path, text, "xBounds", 2);
+  const auto yb = required(path, text, "yBounds", 2);
+  const auto ppm = required(path, text, "pixelsPerMeter", 1);
+  spec.x_min_m = static_cast<float>(xb[0]);
+  spec.x_max_m = static_cast<float>(xb[1]);
+  spec.y_min_m = static_cast<float>(yb[0]);
+  spec.y_max_m = static_cast<float>(yb[1]);
+  spec.pixels_per_meter = static_cast<float>(ppm[0]);
+
+  if (optional_number(path, text, "imageRotation", 0.0) != 0.0)
+    throw Error(path + ": key 'imageRotation': only 0 is supported");
+
+  // channelMap[i] = the costmap channel that image channel i (R, G, B, A) becomes.
+  int source = 0;
+  if (const auto raw = dict_value(text, "channelMap")) {
+    const auto map = dict_numbers(path, "channelMap", *raw);
+    if (map.size() != 4) throw Error(path + ": key 'channelMap' must have 4 entries");
+    source = -1;
+    for (int i = 0; i < 4; ++i)
+      if (map[i] == 0.0) source = i;  // the last one wins, as in the script's copy loop
+    if (source < 0) throw Error(path + ": key 'channelMap' sends no image channel to channel0");
+  }
+  static const char* const kPrefix[4] = {"r", "g", "b", "a"};
+  spec.channel = static_cast<ImageMapSpec::Channel>(source);
+  spec.offset = static_cast<float>(optional_number(path, text, std::string(kPrefix[source]) + "Offset", 0.0));
+  spec.normalizer =
+      static_cast<float>(optional_number(path, text, std::string(kPrefix[source]) + "Normalizer", 1.0));
+  if (spec.normalizer == 0.f)
+    throw Error(path + ": key '" + std::string(kPrefix[source]) + "Normalizer' must not be 0");
+  spec.row0_is_y_max = false;  // track_generator.py never flips (its "flip" key is unused)
+  return spec;
+}
+
+}  // namespace mppi

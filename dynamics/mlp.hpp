@@ -1,0 +1,154 @@
+#pragma once
+// A small fully connected network (multilayer perceptron) evaluated over a fixed-width SoA
+// batch of lanes: out = f_L(W_L ... f_1(W_1 in + b_1) ... + b_L), W stored (out, in) row-major.
+// forward<W>() is hot-loop code (no allocation, no exceptions, branch-free over lanes); it is
+// built as "for each output neuron, for each input: acc[lanes] += w * a[lanes]", so the lane
+// loop is innermost and compiles to broadcast-FMA over vectors.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "mppi/batch.hpp"
+#include "mppi/fast_math.hpp"
+
+namespace mppi {
+
+class NpzFile;
+
+enum class Activation { kTanh, kRelu, kLinear };
+
+struct DenseLayer {
+  int n_in = 0;
+  int n_out = 0;
+  std::vector<float> weights;  // n_out x n_in, row-major
+  std::vector<float> bias;     // n_out
+  Activation activation = Activation::kLinear;
+};
+
+class Mlp {
+ public:
+  Mlp() = default;
+  // Checks that every layer is well formed (sizes > 0, weights n_out x n_in, bias n_out, all
+  // finite) and that the layers chain (n_in of layer i = n_out of layer i - 1). Throws
+  // mppi::Error "Mlp: layer 2 ..." otherwise.
+  explicit Mlp(std::vector<DenseLayer> layers);
+
+  // Layers "<prefix>W1", "<prefix>b1", "<prefix>W2", ... of an npz (W shaped (out, in), b (out,)),
+  // one per entry of `activations`. Throws mppi::Error naming the file and the array if one is
+  // missing, has the wrong shape (does not chain), holds non-finite values, or if the file has
+  // more layers under the prefix than activations were given.
+  static Mlp from_npz(const NpzFile& npz, const std::string& prefix,
+                      const std::vector<Activation>& activations);
+
+  int num_inputs() const { return layers_.empty() ? 0 : layers_.front().n_in; }
+  int num_outputs() const { return layers_.empty() ? 0 : layers_.back().n_out; }
+  int num_layers() const { return static_cast<int>(layers_.size()); }
+  const std::vector<DenseLayer>& layers() const { return layers_; }
+
+  // Scratch floats forward<W>() needs for `width` lanes (two hidden-layer buffers).
+  std::size_t scratch_floats(int width) const {
+    return 2 * static_cast<std::size_t>(max_hidden_) * static_cast<std::size_t>(width);
+  }
+
+  // in: num_inputs() x W, out: num_outputs() x W (both row-major SoA, out may not alias in),
+  // scratch: scratch_floats(W) floats.
+  template <int W>
+  void forward(const float* in, float* out, float* scratch) const noexcept {
+    const float* src = in;
+    const int n = num_layers();
+    for (int l = 0; l < n; ++l) {
+      float* dst = l + 1 == n ? out : scratch + (l & 1) * max_hidden_ * W;
+      dense<W>(layers_[l], src, dst);
+      src = dst;
+    }
+  }
+
+  // One input vector, evaluated in double precision with std::tanh (tests, diagnostics; it
+  // allocates). in: num_inputs(), out: num_outputs().
+  void forward_double(const double* in, double* out) const;
+
+ private:
+  // Lanes per block and output neurons per block of dense(): each input row load feeds
+  // kOutBlock FMAs, and kOutBlock x kLaneBlock accumulators stay in registers (AVX2: 8 ymm,
+  // AVX-512: 4 zmm) as independent FMA chains.
+#ifndef MPPI_MLP_OUT_BLOCK
+#define MPPI_MLP_OUT_BLOCK 2
+#define MPPI_MLP_LANE_BLOCK 32
+#endif
+  static constexpr int kOutBlock = MPPI_MLP_OUT_BLOCK;
+  template <int W>
+  static constexpr int kLaneBlock = W % MPPI_MLP_LANE_BLOCK == 0 ? MPPI_MLP_LANE_BLOCK : W;
+
+  template <int LB>
+  static void activate(Activation act, const float* acc, float* d) noexcept {
+    switch (act) {  // per layer, not per lane
+      case Activation::kTanh:
+        MPPI_SIMD_LOOP
+        for (int j = 0; j < LB; ++j) d[j] = fast_tanh(acc[j]);
+        break;
+      case Activation::kRelu:
+        MPPI_SIMD_LOOP
+        for (int j = 0; j < LB; ++j) d[j] = std::max(acc[j], 0.f);
+        break;
+      case Activation::kLinear:
+        MPPI_SIMD_LOOP
+        for (int j = 0; j < LB; ++j) d[j] = acc[j];
+        break;
+    }
+  }
+
+  // dst[o][lanes] = act(b[o] + sum_i w[o][i] src[i][lanes]); src: n_in x W, dst: n_out x W.
+  template <int W>
+  static void dense(const DenseLayer& layer, const float* src, float* dst) noexcept {
+    constexpr int LB = kLaneBlock<W>;
+    constexpr int OB = kOutBlock;
+    const int n_in = layer.n_in, n_out = layer.n_out;
+    const float* w = layer.weights.data();
+    const float* b = layer.bias.data();
+    for (int l0 = 0; l0 < W; l0 += LB) {
+      int o = 0;
+      for (; o + OB <= n_out; o += OB) {
+        float acc[OB][LB];
+#pragma GCC unroll 8
+        for (int k = 0; k < OB; ++k) {
+          const float bias = b[o + k];
+          MPPI_SIMD_LOOP
+          for (int j = 0; j < LB; ++j) acc[k][j] = bias;
+        }
+        for (int i = 0; i < n_in; ++i) {
+          const float* a = src + static_cast<std::ptrdiff_t>(i) * W + l0;
+#pragma GCC unroll 8
+          for (int k = 0; k < OB; ++k) {
+            const float wk = w[static_cast<std::ptrdiff_t>(o + k) * n_in + i];
+            MPPI_SIMD_LOOP
+            for (int j = 0; j < LB; ++j) acc[k][j] += wk * a[j];
+          }
+        }
+#pragma GCC unroll 8
+        for (int k = 0; k < OB; ++k)
+          activate<LB>(layer.activation, acc[k], dst + static_cast<std::ptrdiff_t>(o + k) * W + l0);
+      }
+      for (; o < n_out; ++o) {  // remaining neurons, one at a time
+        float acc[LB];
+        const float bias = b[o];
+        MPPI_SIMD_LOOP
+        for (int j = 0; j < LB; ++j) acc[j] = bias;
+        const float* w_row = w + static_cast<std::ptrdiff_t>(o) * n_in;
+        for (int i = 0; i < n_in; ++i) {
+          const float wi = w_row[i];
+          const float* a = src + static_cast<std::ptrdiff_t>(i) * W + l0;
+          MPPI_SIMD_LOOP
+          for (int j = 0; j < LB; ++j) acc[j] += wi * a[j];
+        }
+        activate<LB>(layer.activation, acc, dst + static_cast<std::ptrdiff_t>(o) * W + l0);
+      }
+    }
+  }
+
+  std::vector<DenseLayer> layers_;
+  int max_hidden_ = 0;  // widest hidden (non-output) layer
+};
+
+const char* to_string(Activation a);
+
+}  // namespace mppi

@@ -1,0 +1,127 @@
+#pragma once
+// Parameters of the physics vehicle models, with the AutoRally values as defaults, and their
+// YAML loaders (dynamics/vehicle_params_io.cpp). Measured values are from the AutoRally
+// paper's robot-parameter, bifilar-pendulum and tyre tables; the rest (steering range,
+// drivetrain, resistances, regularisation) the paper does not give: they are chosen to be
+// plausible for a 22 kg 1:5 rally car and are meant to be calibrated.
+#include <string>
+
+#include "dynamics/pacejka.hpp"
+
+namespace mppi {
+
+struct SingleTrackParams {
+  // --- measured (paper) ---
+  double mass_kg = 21.88;                 // total mass m [kg]
+  double yaw_inertia_kgm2 = 1.124;        // I_z about the CG [kg m^2] (bifilar)
+  double cg_to_front_axle_m = 0.34;       // l_f [m] = wheelbase 0.57 - l_r
+  double cg_to_rear_axle_m = 0.23;        // l_r [m] (rear axle to CG, x offset)
+  double cg_height_m = 0.12;              // h [m] (rear axle to CG, z offset), for load transfer
+  double wheel_radius_m = 0.0975;         // R [m] (wheel diameter 0.195 m)
+  double front_wheel_inertia_kgm2 = 0.048;  // I_f [kg m^2], both front wheels together (bifilar)
+  double rear_wheel_inertia_kgm2 = 0.044;   // I_r [kg m^2], both rear wheels together (bifilar)
+  double gravity_mps2 = 9.81;             // g [m/s^2] (the paper's value)
+  PacejkaParams tyre;                     // Magic Formula (paper's identified values)
+  // --- chosen (not in the paper) ---
+  double max_steer_rad = 0.38;            // front wheel angle at steer = +-1 [rad]
+  // Rear-wheel drive, DC-motor-like torque-speed line at the rear axle:
+  //   T_rear = stall_torque * (throttle - omega_r R / no_load_speed).
+  // Gives engine braking at zero throttle, braking then reverse for negative throttle.
+  // With the resistances below: steady 5.3 m/s at throttle 0.3, 13.1 at 0.65, 19.6 at 1.
+  double stall_torque_Nm = 10.0;          // rear axle torque at throttle 1, wheel still [N m]
+  double no_load_speed_mps = 30.0;        // rim speed where throttle 1 gives zero torque [m/s]
+  double rolling_resistance = 0.05;       // c_rr [-]: force c_rr m g tanh(vx / v_rr) (loose dirt)
+  double rolling_resistance_speed_mps = 0.5;  // v_rr [m/s]: smooths the sign at standstill
+  double aero_drag_kgpm = 0.05;           // c_d [N s^2/m^2]: force c_d vx |vx| (~0.5 rho Cd A)
+  // Regularisation of the paper's slip formulas (dynamics/pacejka.hpp). Both trade fidelity
+  // for a non-stiff model. The floor bounds the slip stiffness d s / d omega <= R / v_floor:
+  // the fastest (wheel-slip) mode relaxes at about k R^2 f_z (1/I_wheel + 1/(m R^2)) / v_floor
+  // with k the largest slope of the regularised friction curve (3.1 for slip_blend 0.1, from
+  // the paper's mu'(0) = 1.52 and mu(0)/eps). Largest -Re(eigenvalue) x 0.02 s over sampled
+  // states, from the Jacobian (see tests/dynamics/test_single_track.cpp): 0.78 with these
+  // values (explicit Euler: < 1 means no overshoot, < 2 stable); 1.2 at v_floor 2, 2.3 (unstable)
+  // at 1 m/s. The 500 Hz plant would be fine with 1 m/s.
+  double slip_speed_floor_mps = 3.0;      // v_floor [m/s] in max(|omega R|, v_floor)
+  double slip_blend = 0.1;                // eps [-]: force x tanh(s / eps) -> 0 at zero slip
+
+  double wheelbase_m() const { return cg_to_front_axle_m + cg_to_rear_axle_m; }
+  bool is_valid(std::string* why) const;
+};
+
+// The kinematic bicycle: no tyre slip, reference point at the rear-axle centre (the only
+// point of a kinematic bicycle whose velocity has no lateral component, hence vy = 0).
+//   yaw_rate = v tan(delta) / L,  dv/dt = max_accel * throttle - speed_damping * v.
+// Defaults: steady speed 20 m/s x throttle (6 at 0.3, 13 at 0.65), close to the single-track
+// defaults' 5.3 and 13.1; 2.6 m/s^2 from rest at throttle 0.65.
+struct KinematicBicycleParams {
+  double wheelbase_m = 0.57;          // L [m] (paper)
+  double max_steer_rad = 0.38;        // front wheel angle at steer = +-1 [rad]
+  double max_accel_mps2 = 4.0;        // dv/dt at throttle 1 and v = 0 [m/s^2]
+  double speed_damping_per_s = 0.2;   // linear speed damping [1/s]: v_ss = max_accel u / this
+
+  bool is_valid(std::string* why) const;
+};
+
+// YAML loaders. Keys not given keep their defaults; an unknown key, a value that is not a
+// number, or parameters that fail is_valid() throw mppi::Error naming the file, key and line.
+// The single-track file has the fields above as top-level keys and a `tyre:` map with
+// B, C, D, E, Sh, Sv (see data/config/autorally_single_track.yaml).
+SingleTrackParams load_single_track_params(const std::string& path);
+KinematicBicycleParams load_kinematic_bicycle_params(const std::string& path);
+// The same from YAML text; `source` names it in error messages.
+SingleTrackParams single_track_params_from_yaml(const std::string& text, const std::string& source);
+KinematicBicycleParams kinematic_bicycle_params_from_yaml(const std::string& text,
+                                                          const std::string& source);
+
+// ---------------------------------------------------------------------------------------------
+
+inline bool SingleTrackParams::is_valid(std::string* why) const {
+  auto fail = [&](const std::string& msg) {
+    if (why) *why = msg;
+    return false;
+  };
+  auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!positive(mass_kg)) return fail("mass_kg must be > 0");
+  if (!positive(yaw_inertia_kgm2)) return fail("yaw_inertia_kgm2 must be > 0");
+  if (!positive(cg_to_front_axle_m)) return fail("cg_to_front_axle_m must be > 0");
+  if (!positive(cg_to_rear_axle_m)) return fail("cg_to_rear_axle_m must be > 0");
+  if (!(std::isfinite(cg_height_m) && cg_height_m >= 0)) return fail("cg_height_m must be >= 0");
+  if (!positive(wheel_radius_m)) return fail("wheel_radius_m must be > 0");
+  if (!positive(front_wheel_inertia_kgm2)) return fail("front_wheel_inertia_kgm2 must be > 0");
+  if (!positive(rear_wheel_inertia_kgm2)) return fail("rear_wheel_inertia_kgm2 must be > 0");
+  if (!positive(gravity_mps2)) return fail("gravity_mps2 must be > 0");
+  if (!tyre.is_valid(why)) return false;
+  if (!(positive(max_steer_rad) && max_steer_rad < 1.5))
+    return fail("max_steer_rad must be in (0, 1.5)");
+  if (!(std::isfinite(stall_torque_Nm) && stall_torque_Nm >= 0))
+    return fail("stall_torque_Nm must be >= 0");
+  if (!positive(no_load_speed_mps)) return fail("no_load_speed_mps must be > 0");
+  if (!(std::isfinite(rolling_resistance) && rolling_resistance >= 0))
+    return fail("rolling_resistance must be >= 0");
+  if (!positive(rolling_resistance_speed_mps)) return fail("rolling_resistance_speed_mps must be > 0");
+  if (!(std::isfinite(aero_drag_kgpm) && aero_drag_kgpm >= 0)) return fail("aero_drag_kgpm must be >= 0");
+  if (!positive(slip_speed_floor_mps)) return fail("slip_speed_floor_mps must be > 0");
+  if (!positive(slip_blend)) return fail("slip_blend must be > 0");
+  // The load-transfer denominator l_f + l_r + h (mu_Fx cos d - mu_Fy sin d - mu_Rx) stays
+  // positive for any slips when h * 2 * max|mu| < wheelbase.
+  const double mu_bound = std::abs(tyre.D) + std::abs(tyre.Sv);
+  if (!(2 * cg_height_m * mu_bound < wheelbase_m()))
+    return fail("cg_height_m too large for the wheelbase and tyre grip (need 2 h (|D|+|Sv|) < l_f + l_r)");
+  return true;
+}
+
+inline bool KinematicBicycleParams::is_valid(std::string* why) const {
+  auto fail = [&](const std::string& msg) {
+    if (why) *why = msg;
+    return false;
+  };
+  if (!(std::isfinite(wheelbase_m) && wheelbase_m > 0)) return fail("wheelbase_m must be > 0");
+  if (!(std::isfinite(max_steer_rad) && max_steer_rad > 0 && max_steer_rad < 1.5))
+    return fail("max_steer_rad must be in (0, 1.5)");
+  if (!(std::isfinite(max_accel_mps2) && max_accel_mps2 >= 0)) return fail("max_accel_mps2 must be >= 0");
+  if (!(std::isfinite(speed_damping_per_s) && speed_damping_per_s >= 0))
+    return fail("speed_damping_per_s must be >= 0");
+  return true;
+}
+
+}  // namespace mppi

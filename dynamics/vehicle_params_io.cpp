@@ -1,0 +1,149 @@
+// YAML -> SingleTrackParams / KinematicBicycleParams, strict: every mistake is an mppi::Error
+// naming the file, line and key.
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "dynamics/vehicle_params.hpp"
+#include "mppi/error.hpp"
+
+namespace mppi {
+
+namespace {
+
+struct Field {
+  const char* key;
+  double* value;
+};
+
+// "file:line:column" (1-based) of a node, or just "file" when yaml-cpp has no position.
+std::string where(const std::string& source, const YAML::Mark& mark) {
+  if (mark.is_null()) return source;
+  return source + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
+}
+
+std::string key_list(const std::vector<Field>& fields, const char* extra = nullptr) {
+  std::string out;
+  for (const auto& f : fields) out += (out.empty() ? "" : ", ") + std::string(f.key);
+  if (extra) out += std::string(", ") + extra;
+  return out;
+}
+
+double read_number(const YAML::Node& value, const std::string& key, const std::string& source) {
+  if (!value.IsScalar()) throw Error(where(source, value.Mark()) + ": key '" + key + "' must be a number");
+  double v = 0.0;
+  try {
+    v = value.as<double>();
+  } catch (const YAML::Exception&) {
+    throw Error(where(source, value.Mark()) + ": key '" + key + "' must be a number, got '" +
+                value.Scalar() + "'");
+  }
+  if (!std::isfinite(v)) throw Error(where(source, value.Mark()) + ": key '" + key + "' must be finite");
+  return v;
+}
+
+// Reads a map of key: number into `fields`. `nested_key`/`nested` (optional) handle one
+// sub-map, e.g. tyre:. `what` names the parameter set in messages.
+void read_map(const YAML::Node& map, const std::vector<Field>& fields, const std::string& source,
+              const std::string& what, const char* nested_key = nullptr,
+              const std::vector<Field>* nested = nullptr) {
+  if (!map.IsMap()) throw Error(where(source, map.Mark()) + ": " + what + " must be a mapping of key: number");
+  std::set<std::string> seen;
+  for (const auto& item : map) {
+    const YAML::Node& key_node = item.first;
+    const std::string key = key_node.IsScalar() ? key_node.Scalar() : std::string("<non-scalar key>");
+    const std::string at = where(source, key_node.Mark());
+    if (!seen.insert(key).second) throw Error(at + ": key '" + key + "' given twice in " + what);
+    if (nested_key && key == nested_key) {
+      read_map(item.second, *nested, source, what + " '" + key + "'");
+      continue;
+    }
+    double* target = nullptr;
+    for (const auto& f : fields)
+      if (key == f.key) target = f.value;
+    if (!target)
+      throw Error(at + ": unknown key '" + key + "' in " + what + " (known: " + key_list(fields, nested_key) + ")");
+    *target = read_number(item.second, key, source);
+  }
+}
+
+YAML::Node parse(const std::string& text, const std::string& source) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw Error(where(source, e.mark) + ": YAML syntax error: " + e.msg);
+  }
+}
+
+std::string read_file(const std::string& path, const std::string& what) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open " + what + " file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+}  // namespace
+
+SingleTrackParams single_track_params_from_yaml(const std::string& text, const std::string& source) {
+  SingleTrackParams p;
+  const YAML::Node root = parse(text, source);
+  if (!root.IsDefined() || root.IsNull()) return p;  // empty document: all defaults
+  const std::vector<Field> fields = {
+      {"mass_kg", &p.mass_kg},
+      {"yaw_inertia_kgm2", &p.yaw_inertia_kgm2},
+      {"cg_to_front_axle_m", &p.cg_to_front_axle_m},
+      {"cg_to_rear_axle_m", &p.cg_to_rear_axle_m},
+      {"cg_height_m", &p.cg_height_m},
+      {"wheel_radius_m", &p.wheel_radius_m},
+      {"front_wheel_inertia_kgm2", &p.front_wheel_inertia_kgm2},
+      {"rear_wheel_inertia_kgm2", &p.rear_wheel_inertia_kgm2},
+      {"gravity_mps2", &p.gravity_mps2},
+      {"max_steer_rad", &p.max_steer_rad},
+      {"stall_torque_Nm", &p.stall_torque_Nm},
+      {"no_load_speed_mps", &p.no_load_speed_mps},
+      {"rolling_resistance", &p.rolling_resistance},
+      {"rolling_resistance_speed_mps", &p.rolling_resistance_speed_mps},
+      {"aero_drag_kgpm", &p.aero_drag_kgpm},
+      {"slip_speed_floor_mps", &p.slip_speed_floor_mps},
+      {"slip_blend", &p.slip_blend},
+  };
+  const std::vector<Field> tyre = {{"B", &p.tyre.B}, {"C", &p.tyre.C},   {"D", &p.tyre.D},
+                                   {"E", &p.tyre.E}, {"Sh", &p.tyre.Sh}, {"Sv", &p.tyre.Sv}};
+  read_map(root, fields, source, "single-track parameters", "tyre", &tyre);
+  std::string why;
+  if (!p.is_valid(&why)) throw Error(source + ": invalid single-track parameters: " + why);
+  return p;
+}
+
+KinematicBicycleParams kinematic_bicycle_params_from_yaml(const std::string& text,
+                                                          const std::string& source) {
+  KinematicBicycleParams p;
+  const YAML::Node root = parse(text, source);
+  if (!root.IsDefined() || root.IsNull()) return p;
+  const std::vector<Field> fields = {
+      {"wheelbase_m", &p.wheelbase_m},
+      {"max_steer_rad", &p.max_steer_rad},
+      {"max_accel_mps2", &p.max_accel_mps2},
+      {"speed_damping_per_s", &p.speed_damping_per_s},
+  };
+  read_map(root, fields, source, "kinematic bicycle parameters");
+  std::string why;
+  if (!p.is_valid(&why)) throw Error(source + ": invalid kinematic bicycle parameters: " + why);
+  return p;
+}
+
+SingleTrackParams load_single_track_params(const std::string& path) {
+  return single_track_params_from_yaml(read_file(path, "single-track parameter"), path);
+}
+
+KinematicBicycleParams load_kinematic_bicycle_params(const std::string& path) {
+  return kinematic_bicycle_params_from_yaml(read_file(path, "kinematic bicycle parameter"), path);
+}
+
+}  // namespace mppi

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Installs the Debian packages the project builds with (when run as root), or prints the exact
+# apt-get line to run. Sourced by demo.sh and test.sh; safe to run again.
+set -euo pipefail
+
+MPPI_DEBIAN_PACKAGES=(
+  build-essential cmake pkg-config git
+  libeigen3-dev libzip-dev libyaml-cpp-dev libopencv-dev librandom123-dev
+  nlohmann-json3-dev catch2 libbenchmark-dev
+  python3 python3-numpy
+)
+
+mppi_missing_packages() {
+  local missing=()
+  for p in "${MPPI_DEBIAN_PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  echo "${missing[@]:-}"
+}
+
+mppi_setup() {
+  local missing
+  missing=$(mppi_missing_packages)
+  if [ -z "$missing" ]; then
+    return 0
+  fi
+  if [ "$(id -u)" -eq 0 ]; then
+    echo "[setup] installing Debian packages: $missing"
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq
+    # shellcheck disable=SC2086
+    apt-get install -y -qq --no-install-recommends $missing
+  else
+    echo "[setup] missing Debian packages. Run this, then try again:" >&2
+    echo "  sudo apt-get install -y --no-install-recommends $missing" >&2
+    exit 1
+  fi
+}
+
+# Configure and build into build/ (programs in build/bin/).
+mppi_build() {
+  local jobs
+  jobs=$(nproc 2>/dev/null || echo 2)
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@"
+  cmake --build build -j"$jobs"
+}
+
+if [ "${BASH_SOURCE[0]}" = "$0" ]; then
+  cd "$(dirname "$0")/.."
+  mppi_setup
+fi

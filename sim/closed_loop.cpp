@@ -1,0 +1,264 @@
+#include "sim/closed_loop.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <numbers>
+#include <optional>
+#include <vector>
+
+#include "costs/autorally_cost.hpp"
+#include "costs/cost_config.hpp"
+#include "costs/cost_map.hpp"
+#include "dynamics/autorally_nn.hpp"
+#include "dynamics/kinematic_bicycle.hpp"
+#include "dynamics/single_track.hpp"
+#include "dynamics/vehicle_params.hpp"
+#include "mppi/controller.hpp"
+#include "mppi/error.hpp"
+#include "sim/crash_detector.hpp"
+#include "sim/data_dir.hpp"
+#include "sim/geometry.hpp"
+#include "sim/lap_counter.hpp"
+#include "sim/recording.hpp"
+#include "sim/track_plot.hpp"
+
+namespace mppi::sim {
+namespace {
+
+constexpr const char* kDefaultNetwork = "autorally/models/autorally_nnet_09_12_2018.npz";
+constexpr const char* kDefaultCostYaml = "config/autorally_cost.yaml";
+constexpr const char* kDefaultSingleTrackYaml = "config/autorally_single_track.yaml";
+
+SingleTrackParams single_track_params(const std::string& yaml) {
+  return load_single_track_params(yaml.empty() ? data_file(kDefaultSingleTrackYaml) : yaml);
+}
+
+// The controller and how it reads the plant: full plant state -> controller model state.
+struct ControllerSetup {
+  std::unique_ptr<Controller> controller;
+  int model_states = 0;
+  std::function<void(const float* plant_x, int plant_states, float* model_x)> observe;
+};
+
+ControllerSetup make_controller(const ClosedLoopConfig& config, const AutoRallyCost& cost) {
+  ControllerSetup setup;
+  auto copy_common = [](const float* px, int, float* mx) {
+    std::copy(px, px + state::kCommonStates, mx);
+  };
+  if (config.model == "autorally-nn") {
+    auto model = AutoRallyNetwork::load(config.network_npz.empty() ? data_file(kDefaultNetwork)
+                                                                   : config.network_npz);
+    setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
+    setup.model_states = AutoRallyNetwork::kNx;
+    setup.observe = copy_common;
+  } else if (config.model == "single-track") {
+    const SingleTrack model(single_track_params(config.model_params_yaml));
+    setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
+    setup.model_states = SingleTrack::kNx;
+    const float radius = static_cast<float>(model.params().wheel_radius_m);
+    setup.observe = [radius](const float* px, int plant_states, float* mx) {
+      if (plant_states == SingleTrack::kNx) {
+        std::copy(px, px + SingleTrack::kNx, mx);  // same model: wheel speeds are known
+      } else {
+        std::copy(px, px + state::kCommonStates, mx);
+        mx[SingleTrack::kOmegaFront] = mx[SingleTrack::kOmegaRear] = px[state::kVx] / radius;
+      }
+    };
+  } else if (config.model == "kinematic") {
+    const KinematicBicycleParams params = config.model_params_yaml.empty()
+                                              ? KinematicBicycleParams{}
+                                              : load_kinematic_bicycle_params(config.model_params_yaml);
+    const KinematicBicycle model(params);
+    setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
+    setup.model_states = KinematicBicycle::kNx;
+    // The kinematic bicycle's reference point is the rear axle, l_r behind the CG.
+    const float l_r = static_cast<float>(SingleTrackParams{}.cg_to_rear_axle_m);
+    setup.observe = [l_r](const float* px, int, float* mx) {
+      std::copy(px, px + state::kCommonStates, mx);
+      mx[state::kX] -= l_r * std::cos(px[state::kYaw]);
+      mx[state::kY] -= l_r * std::sin(px[state::kYaw]);
+      mx[state::kVy] = 0.f;
+    };
+  } else {
+    throw Error("unknown controller model '" + config.model +
+                "' (valid: autorally-nn, single-track, kinematic)");
+  }
+  return setup;
+}
+
+std::string format_times(const std::vector<double>& times) {
+  std::string s;
+  char buf[32];
+  for (double t : times) {
+    std::snprintf(buf, sizeof buf, "%s%.2f", s.empty() ? "" : ", ", t);
+    s += buf;
+  }
+  return s;
+}
+
+template <VehicleDynamics P>
+RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const Track& track,
+                          const AutoRallyCost& cost) {
+  ControllerSetup setup = make_controller(config, cost);
+  Controller& controller = *setup.controller;
+  Plant<P> plant(std::move(plant_model), config.actuators, static_cast<float>(config.plant_dt_s));
+  const Pose2 start = track.start_pose();
+  VehicleState s0;
+  s0.x_m = static_cast<float>(start.x_m);
+  s0.y_m = static_cast<float>(start.y_m);
+  s0.yaw_rad = static_cast<float>(start.yaw_rad);
+  plant.reset(s0);
+
+  LapCounter laps(track);
+  laps.reset({start.x_m, start.y_m}, 0.0);
+  const CrashDetector crash_detector(track);
+
+  const double control_dt = config.controller.dt_s;
+  const int substeps = std::max(1, static_cast<int>(std::lround(control_dt / config.plant_dt_s)));
+  const double max_time = config.max_time_s > 0
+                              ? config.max_time_s
+                              : 30.0 + config.laps * track.length_m() /
+                                           std::max(1.0, 0.3 * config.target_speed_mps);
+
+  std::unique_ptr<RecordingWriter> log;
+  if (!config.out_dir.empty()) {
+    std::filesystem::create_directories(config.out_dir);
+    log = std::make_unique<RecordingWriter>(
+        config.out_dir + "/log.csv",
+        std::vector<std::string>{"roll", "applied_steer", "applied_throttle", "progress_m",
+                                 "lap", "optimizer_ms", "effective_sample_size", "min_cost"},
+        std::vector<std::pair<std::string, std::string>>{
+            {"source", "mppi-sim"}, {"track", track.name()}, {"model", config.model},
+            {"plant", config.plant}, {"seed", std::to_string(config.controller.seed)},
+            {"target_speed_mps", std::to_string(config.target_speed_mps)}});
+  }
+
+  RunSummary summary;
+  summary.track = track.name();
+  summary.model = config.model;
+  summary.plant = config.plant;
+  summary.seed = config.controller.seed;
+  summary.samples = config.controller.num_samples;
+  summary.horizon = config.controller.horizon;
+  summary.target_speed_mps = config.target_speed_mps;
+
+  std::vector<float> model_x(static_cast<std::size_t>(setup.model_states));
+  std::vector<double> optimizer_ms, ess;
+  std::vector<PathSample> path;
+  std::vector<std::pair<float, float>> crash_points;
+  double speed_sum = 0.0;
+  long speed_samples = 0;
+  bool in_contact = false;
+  double t = 0.0;
+  int reported_laps = 0;
+  double last_lap_end = 0.0;
+  StepSummary step_summary;
+  while (t < max_time && laps.laps_completed() < config.laps) {
+    setup.observe(plant.state(), P::kNx, model_x.data());
+    const auto u = controller.step(model_x, &step_summary);
+    const Control command{u[control::kSteer], u[control::kThrottle]};
+    optimizer_ms.push_back(step_summary.optimizer_ms);
+    ess.push_back(step_summary.effective_sample_size);
+    for (int i = 0; i < substeps; ++i) {
+      plant.advance(command, static_cast<float>(config.plant_dt_s));
+      t += config.plant_dt_s;
+      const VehicleState s = plant.vehicle_state();
+      laps.update({s.x_m, s.y_m}, t);
+      const CrashResult crash = crash_detector.check(s.x_m, s.y_m, s.yaw_rad);
+      if (crash.crashed && !in_contact) {
+        ++summary.crashes;
+        summary.crash_reasons.push_back(crash.reason);
+        crash_points.emplace_back(static_cast<float>(crash.x_m), static_cast<float>(crash.y_m));
+        if (config.progress)
+          std::fprintf(stderr, "  crash at t = %.2f s: %s\n", t, crash.reason.c_str());
+        // A marshal puts the car back on the centreline, at rest, facing along the track.
+        const ClosestPoint c = closest_point(track.centreline(), true, {s.x_m, s.y_m});
+        const Vec2 a = track.centreline()[c.segment];
+        const Vec2 b = track.centreline()[(c.segment + 1) % track.centreline().size()];
+        VehicleState respawn;
+        respawn.x_m = static_cast<float>(c.point.x);
+        respawn.y_m = static_cast<float>(c.point.y);
+        respawn.yaw_rad = static_cast<float>(std::atan2(b.y - a.y, b.x - a.x));
+        plant.reset(respawn);
+        controller.reset();
+        in_contact = false;
+        break;  // new control step from the respawned state
+      }
+      in_contact = crash.crashed;
+    }
+    const VehicleState s = plant.vehicle_state();
+    const double speed = std::hypot(s.vx_mps, s.vy_mps);
+    speed_sum += speed;
+    ++speed_samples;
+    summary.max_speed_mps = std::max(summary.max_speed_mps, speed);
+    path.push_back({s.x_m, s.y_m, static_cast<float>(speed)});
+    if (log) {
+      const double extras[] = {s.roll_rad, plant.applied().steer, plant.applied().throttle,
+                               laps.progress_m(), static_cast<double>(laps.laps_completed()),
+                               step_summary.optimizer_ms, step_summary.effective_sample_size,
+                               step_summary.min_cost};
+      log->write(t, s, command, extras);
+    }
+    if (!std::isfinite(s.x_m) || !std::isfinite(s.vx_mps))
+      throw Error("the plant state became non-finite at t = " + std::to_string(t) + " s");
+    if (laps.laps_completed() > reported_laps && config.progress) {
+      reported_laps = laps.laps_completed();
+      const double lap_time = laps.lap_times_s().back();
+      std::fprintf(stderr, "lap %d/%d: %.2f s (mean %.2f m/s), crashes so far %d, t = %.1f s\n",
+                   reported_laps, config.laps, lap_time, track.length_m() / lap_time,
+                   summary.crashes, t);
+      last_lap_end = t;
+    }
+  }
+  (void)last_lap_end;
+  summary.sim_time_s = t;
+  summary.laps_completed = laps.laps_completed();
+  summary.lap_times_s = laps.lap_times_s();
+  summary.finished = summary.laps_completed >= config.laps;
+  summary.mean_speed_mps = speed_samples ? speed_sum / speed_samples : 0.0;
+  summary.optimizer_ms_p50 = percentile(optimizer_ms, 50);
+  summary.optimizer_ms_p99 = percentile(optimizer_ms, 99);
+  double ess_sum = 0;
+  for (double e : ess) ess_sum += e;
+  summary.effective_sample_size_mean = ess.empty() ? 0.0 : ess_sum / ess.size();
+  if (log) {
+    log->close();
+    char title[256];
+    std::snprintf(title, sizeof title, "%s | model %s, plant %s | %d laps [%s] s | crashes %d",
+                  track.name().c_str(), config.model.c_str(), config.plant.c_str(),
+                  summary.laps_completed, format_times(summary.lap_times_s).c_str(),
+                  summary.crashes);
+    plot_track_run(config.out_dir + "/track.png", track, path, crash_points, title);
+    write_summary(config.out_dir + "/summary.json", summary);
+  }
+  return summary;
+}
+
+}  // namespace
+
+RunSummary run_closed_loop(const ClosedLoopConfig& config) {
+  TrackOptions track_options;
+  track_options.direction = config.clockwise ? Direction::kClockwise : Direction::kCounterClockwise;
+  const Track track = Track::load(config.track, track_options);
+  AutoRallyCostParams cost_params = load_autorally_cost_params(
+      config.cost_params_yaml.empty() ? data_file(kDefaultCostYaml) : config.cost_params_yaml);
+  cost_params.target_speed_mps = static_cast<float>(config.target_speed_mps);
+  const AutoRallyCost cost(std::make_shared<const CostMap>(CostMap::load_npz(track.costmap_path())),
+                           cost_params);
+  if (config.laps < 1) throw Error("laps must be >= 1");
+  if (config.plant == "single-track")
+    return run_with_plant(config, SingleTrack(single_track_params(config.plant_params_yaml)), track, cost);
+  if (config.plant == "autorally-nn")
+    return run_with_plant(config,
+                          AutoRallyNetwork::load(config.network_npz.empty() ? data_file(kDefaultNetwork)
+                                                                            : config.network_npz),
+                          track, cost);
+  if (config.plant == "kinematic") return run_with_plant(config, KinematicBicycle(), track, cost);
+  throw Error("unknown plant '" + config.plant + "' (valid: single-track, autorally-nn, kinematic)");
+}
+
+}  // namespace mppi::sim

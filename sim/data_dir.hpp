@@ -1,0 +1,15 @@
+#pragma once
+// Where the simulator finds its data files (cost maps, track boundaries, model weights):
+// $MPPI_DATA_DIR if set, else the data/ folder of the source tree (fixed at build time).
+#include <string>
+
+namespace mppi::sim {
+
+// The data root. Throws mppi::Error if the folder has no autorally/ subfolder (naming the
+// folder and where its path came from).
+std::string data_dir();
+
+// data_dir() + "/" + relative. Throws mppi::Error naming the full path if the file is missing.
+std::string data_file(const std::string& relative);
+
+}  // namespace mppi::sim

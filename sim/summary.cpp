@@ -1,0 +1,63 @@
+#include "sim/summary.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+
+#include <nlohmann/json.hpp>
+
+#include "mppi/error.hpp"
+
+namespace mppi::sim {
+
+namespace {
+nlohmann::ordered_json number(double v) {
+  return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
+}
+}  // namespace
+
+std::string to_json(const RunSummary& s) {
+  nlohmann::ordered_json j;
+  j["track"] = s.track;
+  j["model"] = s.model;
+  j["plant"] = s.plant;
+  j["seed"] = s.seed;
+  j["samples"] = s.samples;
+  j["horizon"] = s.horizon;
+  j["target_speed_mps"] = number(s.target_speed_mps);
+  j["sim_time_s"] = number(s.sim_time_s);
+  j["finished"] = s.finished;
+  j["laps_completed"] = s.laps_completed;
+  j["lap_times_s"] = nlohmann::ordered_json::array();
+  for (double t : s.lap_times_s) j["lap_times_s"].push_back(number(t));
+  j["crashes"] = s.crashes;
+  j["crash_reasons"] = s.crash_reasons;
+  j["mean_speed_mps"] = number(s.mean_speed_mps);
+  j["max_speed_mps"] = number(s.max_speed_mps);
+  j["optimizer_ms_p50"] = number(s.optimizer_ms_p50);
+  j["optimizer_ms_p99"] = number(s.optimizer_ms_p99);
+  j["effective_sample_size_mean"] = number(s.effective_sample_size_mean);
+  return j.dump(2) + "\n";
+}
+
+void write_summary(const std::string& path, const RunSummary& summary) {
+  std::ofstream out(path, std::ios::out | std::ios::trunc);
+  if (!out) throw Error(path + ": cannot open for writing");
+  out << to_json(summary);
+  out.close();
+  if (!out) throw Error(path + ": write failed");
+}
+
+double percentile(std::vector<double> values, double p) {
+  if (!(p >= 0.0 && p <= 100.0)) throw Error("percentile: p must be in [0, 100]");
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(values.begin(), values.end());
+  const double rank = p / 100.0 * static_cast<double>(values.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(rank));
+  const std::size_t hi = std::min(lo + 1, values.size() - 1);
+  const double frac = rank - static_cast<double>(lo);
+  return values[lo] + frac * (values[hi] - values[lo]);
+}
+
+}  // namespace mppi::sim

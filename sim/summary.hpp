@@ -1,0 +1,40 @@
+#pragma once
+// The summary of one closed-loop run, written as JSON next to the run's recording and plot.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace mppi::sim {
+
+struct RunSummary {
+  std::string track;                  // "gazebo", ...
+  std::string model;                  // the controller's dynamics model
+  std::string plant;                  // the simulated car's model
+  std::uint64_t seed = 0;
+  int samples = 0;                    // MPPI rollouts per step
+  int horizon = 0;                    // MPPI time steps
+  double target_speed_mps = 0.0;
+  double sim_time_s = 0.0;
+  bool finished = false;              // reached the requested laps / time without stopping early
+  int laps_completed = 0;
+  std::vector<double> lap_times_s;
+  int crashes = 0;
+  std::vector<std::string> crash_reasons;
+  double mean_speed_mps = 0.0;
+  double max_speed_mps = 0.0;
+  double optimizer_ms_p50 = 0.0;      // wall time of one controller step, median
+  double optimizer_ms_p99 = 0.0;
+  double effective_sample_size_mean = 0.0;
+};
+
+// Pretty-printed JSON object with one key per field above (same names). NaN / inf -> null.
+std::string to_json(const RunSummary& summary);
+// Writes to_json() to `path`. Throws mppi::Error if the file cannot be written.
+void write_summary(const std::string& path, const RunSummary& summary);
+
+// The p-th percentile (p in [0, 100]) with linear interpolation between order statistics,
+// like numpy.percentile's default: rank = p / 100 * (n - 1). NaN for an empty vector.
+// Throws mppi::Error if p is outside [0, 100] or NaN.
+double percentile(std::vector<double> values, double p);
+
+}  // namespace mppi::sim

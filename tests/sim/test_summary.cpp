@@ -1,0 +1,82 @@
+// Run summary JSON and the percentile helper (oracle: numpy.percentile, default 'linear').
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include <nlohmann/json.hpp>
+
+#include "mppi/error.hpp"
+#include "sim/summary.hpp"
+
+using namespace mppi::sim;
+using Catch::Approx;
+
+TEST_CASE("percentile matches numpy.percentile", "[sim]") {
+  const std::vector<double> v{3.2, 1.5, 9.75, 4.0, 2.25, 7.5, 0.5};
+  // python: np.percentile(v, p)
+  CHECK(percentile(v, 0) == Approx(0.5));
+  CHECK(percentile(v, 10) == Approx(1.1));
+  CHECK(percentile(v, 25) == Approx(1.875));
+  CHECK(percentile(v, 50) == Approx(3.2));
+  CHECK(percentile(v, 90) == Approx(8.4));
+  CHECK(percentile(v, 99) == Approx(9.614999999999998));
+  CHECK(percentile(v, 100) == Approx(9.75));
+  CHECK(percentile({5.0, 1.0}, 50) == Approx(3.0));
+  CHECK(percentile({5.0, 1.0}, 99) == Approx(4.96));
+  CHECK(percentile({42.0}, 37) == 42.0);
+  CHECK(std::isnan(percentile({}, 50)));
+  CHECK_THROWS_AS(percentile(v, 101), mppi::Error);
+  CHECK_THROWS_AS(percentile(v, -1), mppi::Error);
+  CHECK_THROWS_AS(percentile(v, std::nan("")), mppi::Error);
+}
+
+TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
+  RunSummary s;
+  s.track = "gazebo";
+  s.model = "nn_autorally";
+  s.plant = "single_track";
+  s.seed = 1234567890123ULL;
+  s.samples = 1920;
+  s.horizon = 100;
+  s.target_speed_mps = 6.0;
+  s.sim_time_s = 60.0;
+  s.finished = true;
+  s.laps_completed = 2;
+  s.lap_times_s = {12.5, 11.75};
+  s.crashes = 1;
+  s.crash_reasons = {"hit the outer barrier at (1.00, 2.00)"};
+  s.mean_speed_mps = 5.5;
+  s.max_speed_mps = 7.25;
+  s.optimizer_ms_p50 = 1.5;
+  s.optimizer_ms_p99 = std::numeric_limits<double>::quiet_NaN();
+  s.effective_sample_size_mean = 42.5;
+  const auto j = nlohmann::json::parse(to_json(s));
+  CHECK(j.size() == 19);
+  CHECK(j.at("track") == "gazebo");
+  CHECK(j.at("model") == "nn_autorally");
+  CHECK(j.at("plant") == "single_track");
+  CHECK(j.at("seed").get<std::uint64_t>() == 1234567890123ULL);
+  CHECK(j.at("samples") == 1920);
+  CHECK(j.at("horizon") == 100);
+  CHECK(j.at("target_speed_mps") == 6.0);
+  CHECK(j.at("sim_time_s") == 60.0);
+  CHECK(j.at("finished") == true);
+  CHECK(j.at("laps_completed") == 2);
+  CHECK(j.at("lap_times_s") == nlohmann::json::array({12.5, 11.75}));
+  CHECK(j.at("crashes") == 1);
+  CHECK(j.at("crash_reasons")[0] == "hit the outer barrier at (1.00, 2.00)");
+  CHECK(j.at("mean_speed_mps") == 5.5);
+  CHECK(j.at("max_speed_mps") == 7.25);
+  CHECK(j.at("optimizer_ms_p50") == 1.5);
+  CHECK(j.at("optimizer_ms_p99").is_null());
+  CHECK(j.at("effective_sample_size_mean") == 42.5);
+
+  const std::string path = (std::filesystem::temp_directory_path() / "mppi_sim_test_summary.json").string();
+  write_summary(path, s);
+  std::ifstream in(path);
+  CHECK(nlohmann::json::parse(in) == j);
+  CHECK_THROWS_AS(write_summary("/nonexistent-dir/summary.json", s), mppi::Error);
+}
