@@ -4,7 +4,9 @@
 // forward<W>() is hot-loop code (no allocation, no exceptions, branch-free over lanes); it is
 // built as "for each output neuron, for each input: acc[lanes] += w * a[lanes]", so the lane
 // loop is innermost and compiles to broadcast-FMA over vectors.
+#include <bit>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -68,16 +70,13 @@ class Mlp {
   void forward_double(const double* in, double* out) const;
 
  private:
-  // Lanes per block and output neurons per block of dense(): each input row load feeds
-  // kOutBlock FMAs, and kOutBlock x kLaneBlock accumulators stay in registers (AVX2: 8 ymm,
-  // AVX-512: 4 zmm) as independent FMA chains.
-#ifndef MPPI_MLP_OUT_BLOCK
-#define MPPI_MLP_OUT_BLOCK 2
-#define MPPI_MLP_LANE_BLOCK 32
-#endif
-  static constexpr int kOutBlock = MPPI_MLP_OUT_BLOCK;
+  // dense() works on blocks of kOutBlock output neurons x kLaneBlock lanes: each load of an
+  // input row segment feeds kOutBlock FMAs, and the 4 x 16 accumulators stay in registers as
+  // independent FMA chains (AVX-512: 4 zmm, AVX2: 8 ymm). Measured on Zen 4 for the 6-32-32-4
+  // net at W = 64, the matrix part took ~30 ns/sample against ~45 for one neuron x 64 lanes.
+  static constexpr int kOutBlock = 4;
   template <int W>
-  static constexpr int kLaneBlock = W % MPPI_MLP_LANE_BLOCK == 0 ? MPPI_MLP_LANE_BLOCK : W;
+  static constexpr int kLaneBlock = W % 16 == 0 ? 16 : W;
 
   template <int LB>
   static void activate(Activation act, const float* acc, float* d) noexcept {
@@ -87,8 +86,13 @@ class Mlp {
         for (int j = 0; j < LB; ++j) d[j] = fast_tanh(acc[j]);
         break;
       case Activation::kRelu:
+        // max(x, 0) on the bits: clear x if its sign bit is set. Integer ops vectorise with
+        // any floating-point flags (a float compare does not under -ftrapping-math on AVX2).
         MPPI_SIMD_LOOP
-        for (int j = 0; j < LB; ++j) d[j] = std::max(acc[j], 0.f);
+        for (int j = 0; j < LB; ++j) {
+          const auto bits = std::bit_cast<std::int32_t>(acc[j]);
+          d[j] = std::bit_cast<float>(bits & ~(bits >> 31));
+        }
         break;
       case Activation::kLinear:
         MPPI_SIMD_LOOP

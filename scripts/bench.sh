@@ -66,4 +66,11 @@ for name, m in med.items():
     if mm and f"BM_BareLimit/{mm.group(1)}" in med:
         bare = med[f"BM_BareLimit/{mm.group(1)}"]
         print(f"full/bare ({mm.group(1)}): {m:.3f} / {bare:.3f} ms = {m / bare:.2f}x (target <= 1.5x)")
+        th = mm.group(1)
+        parts = [f"BM_NoiseSampling/{th}", f"BM_Rollout/{th}"]
+        if all(p in med for p in parts):
+            s, r = med[parts[0]], med[parts[1]]
+            print(f"  of which sampling {s:.3f} ms ({100 * s / m:.0f}%), rollout {r:.3f} ms "
+                  f"({100 * r / m:.0f}%, network alone {med.get(f'BM_NetworkRollout/{th}', float('nan')):.3f}),"
+                  f" weights/update/rest {m - s - r:.3f} ms")
 PY

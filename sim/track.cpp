@@ -46,7 +46,10 @@ Polyline counter_clockwise(Polyline p) {
   return p;
 }
 
-// Index of the vertex in the middle of the straightest stretch of +-half_window_m.
+// Index of the vertex in the middle of the straightest stretch: the window sums of the turning
+// angle over +-half_window_m are computed for every vertex; among the vertices within 0.02 rad
+// of the smallest sum, the longest consecutive run wins (the first one found on a tie), and its
+// middle vertex is returned. Runs make the choice stable where two straights tie.
 std::size_t straightest_vertex(const Polyline& line, double spacing_m, double half_window_m) {
   const std::size_t n = line.size();
   std::vector<double> turn(n);
@@ -56,18 +59,31 @@ std::size_t straightest_vertex(const Polyline& line, double spacing_m, double ha
   }
   const auto w = static_cast<std::ptrdiff_t>(
       std::min<double>(std::lround(half_window_m / spacing_m), static_cast<double>(n / 4)));
-  std::size_t best = 0;
-  double best_sum = std::numeric_limits<double>::infinity();
   const auto sn = static_cast<std::ptrdiff_t>(n);
-  for (std::ptrdiff_t i = 0; i < sn; ++i) {
-    double sum = 0.0;
-    for (std::ptrdiff_t k = -w; k <= w; ++k) sum += turn[static_cast<std::size_t>(((i + k) % sn + sn) % sn)];
-    if (sum < best_sum - 1e-12) {
-      best_sum = sum;
-      best = static_cast<std::size_t>(i);
+  std::vector<double> sum(n, 0.0);
+  for (std::ptrdiff_t i = 0; i < sn; ++i)
+    for (std::ptrdiff_t k = -w; k <= w; ++k)
+      sum[static_cast<std::size_t>(i)] += turn[static_cast<std::size_t>(((i + k) % sn + sn) % sn)];
+  const double limit = *std::min_element(sum.begin(), sum.end()) + 0.02;
+  // Start scanning just after a vertex outside the limit so no run is split.
+  std::size_t first = n;
+  for (std::size_t i = 0; i < n; ++i)
+    if (sum[i] > limit) {
+      first = i;
+      break;
+    }
+  if (first == n) return 0;  // equally curved everywhere (a circle)
+  std::size_t best_start = 0, best_len = 0, run_start = 0, run_len = 0;
+  for (std::size_t k = 1; k <= n; ++k) {
+    const std::size_t i = (first + k) % n;
+    if (sum[i] <= limit) {
+      if (run_len == 0) run_start = i;
+      if (++run_len > best_len) best_len = run_len, best_start = run_start;
+    } else {
+      run_len = 0;
     }
   }
-  return best;
+  return (best_start + best_len / 2) % n;
 }
 
 }  // namespace
@@ -107,10 +123,30 @@ Polyline centreline_between(const Polyline& inner, const Polyline& outer, double
     }
     mids[i] = 0.5 * (in[i] + q);
   }
-  // Smooth over +-0.5 m twice: removes the kinks where the nearest outer point jumps.
+  // Moving average over +-0.5 m: removes the kinks where the nearest outer point jumps.
+  // (It pulls a curve of radius R inwards by about spacing^2 / R: 1 cm at R = 6 m.)
   Polyline centre = resample(mids, true, spacing_m);
   const int half = std::max(1, static_cast<int>(std::lround(0.5 / spacing_m)));
-  centre = smooth(centre, true, half, 2);
+  centre = smooth(centre, true, half, 1);
+  // Around a hairpin the nearest-point midpoints cut the corner; re-centre each vertex along
+  // its normal until it is as far from one boundary as from the other (the medial line).
+  const bool inner_ccw = signed_area(inner) > 0.0;
+  for (int iteration = 0; iteration < 3; ++iteration) {
+    centre = resample(centre, true, spacing_m);
+    const std::size_t n = centre.size();
+    Polyline moved(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec2 tangent = centre[(i + 1) % n] - centre[(i + n - 1) % n];
+      const double len = norm(tangent);
+      // Left normal; the inner boundary lies to the left when both run counter-clockwise.
+      Vec2 to_inner = len > 0.0 ? Vec2{-tangent.y / len, tangent.x / len} : Vec2{};
+      if (!inner_ccw) to_inner = -1.0 * to_inner;
+      const double d_in = closest_point(inner, true, centre[i]).distance_m;
+      const double d_out = closest_point(outer, true, centre[i]).distance_m;
+      moved[i] = centre[i] + (0.5 * (d_in - d_out)) * to_inner;
+    }
+    centre = smooth(moved, true, half, 1);
+  }
   return resample(centre, true, spacing_m);
 }
 

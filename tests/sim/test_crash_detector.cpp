@@ -11,7 +11,6 @@
 #include "test_data.hpp"
 
 using namespace mppi::sim;
-using Catch::Approx;
 using Catch::Matchers::Contains;
 
 namespace {

@@ -7,7 +7,6 @@
 #include "sim/geometry.hpp"
 
 using namespace mppi::sim;
-using Catch::Approx;
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;

@@ -5,13 +5,13 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <unistd.h>
 
 #include "sim/track.hpp"
 #include "sim/track_plot.hpp"
 #include "test_data.hpp"
 
 using namespace mppi::sim;
-using Catch::Approx;
 
 namespace {
 // Turbo colour map (A. Mikhailov, Google, 2019), entries 0, 128 and 255 of the 256-entry
@@ -48,12 +48,14 @@ TEST_CASE("track plot: size, y up, path coloured by speed, crashes in red", "[si
     path.push_back({static_cast<float>(p.x), static_cast<float>(p.y), v});
   }
   const Vec2 crash = t.centreline()[n / 2 + 5];
-  const std::string png = (std::filesystem::temp_directory_path() / "mppi_sim_test_plot.png").string();
+  const std::string png = (std::filesystem::temp_directory_path() /
+                           ("mppi_sim_test_plot_" + std::to_string(::getpid()) + ".png")).string();
   std::filesystem::remove(png);
   plot_track_run(png, t, path, {{static_cast<float>(crash.x), static_cast<float>(crash.y)}},
                  "gazebo - single_track\nlaps 1: 12.34 s");
 
   const RgbImage img = read_image_rgb(png);
+  std::filesystem::remove(png);
   const PlotFrame frame(t, 1000, 2);
   CHECK(img.width == 1000);
   CHECK(img.height == frame.height_px());
