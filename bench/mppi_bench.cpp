@@ -151,7 +151,7 @@ void BM_BareLimit(benchmark::State& state) {
   }
   set_rate_counters(state, threads);
   // 6x32 + 32x32 + 32x4 multiply-adds and 64 tanh per rollout step
-  state.counters["GFMA/s"] = benchmark::Counter(
+  state.counters["GFMA"] = benchmark::Counter(
       1344.0 * kSamples * kHorizon * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
   state.counters["checksum"] = bare.checksum();
 }
@@ -240,13 +240,15 @@ BENCHMARK(BM_NetworkRollout)->Apply(thread_args);
 BENCHMARK(BM_Rollout)->Apply(thread_args);
 BENCHMARK(BM_CostMapLookup)->Apply(thread_args);
 
-std::string cpu_model() {
+// A field of the first processor in /proc/cpuinfo ("model name", "cpu family", ...).
+std::string cpuinfo(const std::string& key) {
   std::ifstream f("/proc/cpuinfo");
   std::string line;
   while (std::getline(f, line))
-    if (line.rfind("model name", 0) == 0) {
+    if (line.rfind(key, 0) == 0 && line.find(':') != std::string::npos) {
       const auto colon = line.find(':');
-      return colon == std::string::npos ? line : line.substr(colon + 2);
+      const auto start = line.find_first_not_of(" \t", colon + 1);
+      return start == std::string::npos ? std::string() : line.substr(start);
     }
   return "unknown";
 }
@@ -300,9 +302,16 @@ int main(int argc, char** argv) {
   }
   std::fputs(check.c_str(), stderr);
   if (!ok) return 1;
-  benchmark::AddCustomContext("cpu_model", cpu_model());
+  benchmark::AddCustomContext("cpu_model", cpuinfo("model name"));
+  benchmark::AddCustomContext("cpu_family_model_stepping", cpuinfo("cpu family") + " / " +
+                                                               cpuinfo("model\t") + " / " +
+                                                               cpuinfo("stepping"));
   benchmark::AddCustomContext("dispatch_isa", mppi::bench::BareLimit::dispatched_isa());
+#if defined(__clang__)
+  benchmark::AddCustomContext("compiler", "Clang " __clang_version__);
+#else
   benchmark::AddCustomContext("compiler", "GCC " __VERSION__);
+#endif
   benchmark::AddCustomContext("cxx_flags", MPPI_BENCH_CXX_FLAGS);
   benchmark::AddCustomContext("cmake_build_type", MPPI_BENCH_BUILD_TYPE);
   benchmark::AddCustomContext("omp_max_threads", std::to_string(omp_get_max_threads()));
@@ -311,6 +320,10 @@ int main(int argc, char** argv) {
   benchmark::AddCustomContext("K", std::to_string(kSamples));
   benchmark::AddCustomContext("T", std::to_string(kHorizon));
   benchmark::AddCustomContext("bare_check", check.substr(0, check.find('\n')));
+  benchmark::AddCustomContext(
+      "library_build_type_note",
+      "library_build_type is how Google Benchmark itself was built (Debian's package says "
+      "debug); the measured code is built as cmake_build_type with cxx_flags");
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

@@ -2,8 +2,11 @@
 // A small fully connected network (multilayer perceptron) evaluated over a fixed-width SoA
 // batch of lanes: out = f_L(W_L ... f_1(W_1 in + b_1) ... + b_L), W stored (out, in) row-major.
 // forward<W>() is hot-loop code (no allocation, no exceptions, branch-free over lanes); it is
-// built as "for each output neuron, for each input: acc[lanes] += w * a[lanes]", so the lane
-// loop is innermost and compiles to broadcast-FMA over vectors.
+// built as "for each block of output neurons, for each input: acc[k][lanes] += w[k] * a[lanes]",
+// so the lane loop is innermost and compiles to broadcast-FMA over vectors.
+// Speed (Zen 4, one core, W = 64, AutoRally's 6-32-32-4 tanh net): ~47 ns per sample, of which
+// ~19 ns is fast_tanh. fast_tanh's float clamp only vectorises on AVX2/SSE with
+// -fno-trapping-math (mppi::core sets it); without it the same net takes ~160 ns on AVX2.
 #include <bit>
 #include <cstddef>
 #include <cstdint>
