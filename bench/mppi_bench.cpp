@@ -8,7 +8,7 @@
 //   BM_NoiseSampling/threads:N   drawing the K x T x 2 clamped perturbed controls
 //   BM_NetworkRollout/threads:N  backend rollout, network + kinematics, cost = 0
 //   BM_Rollout/threads:N         backend rollout, network + AutoRallyCost (what step() runs)
-//   BM_CostMapLookup/threads:N   K x T cost-map lookups (bilinear/nearest as the cost does it)
+//   BM_CostMapLookup/threads:N   K x T cost-map lookups (nearest pixel, clamped, as the cost does)
 // N is the OpenMP thread count. Times are wall-clock (UseRealTime). items = K*T rollout steps.
 // Standard Google Benchmark flags: --benchmark_format=json, --benchmark_out=FILE,
 // --benchmark_repetitions=N, --benchmark_filter=REGEX. The JSON context has the CPU (Google
@@ -18,7 +18,9 @@
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <memory>

@@ -217,6 +217,7 @@ class Controller {
     for (int row = 0; row < rows; ++row) {
       const float* vr = v + static_cast<std::size_t>(row) * padded;
       float acc = 0.f;
+#pragma omp simd reduction(+ : acc)
       for (int k = 0; k < k_count; ++k) acc += w[k] * vr[k];
       next[row] = acc;
     }
