@@ -1,0 +1,52 @@
+// Controller::step() must not allocate: a counting replacement of the global operator new
+// (in force for the whole test program; it only counts while `counting` is set).
+#include <atomic>
+#include <catch2/catch.hpp>
+#include <cstdlib>
+#include <new>
+
+#include "mppi/controller.hpp"
+#include "tests/mppi/linear_system.hpp"
+
+namespace {
+std::atomic<bool> counting{false};
+std::atomic<long> allocations{0};
+}  // namespace
+
+void* operator new(std::size_t size) {
+  if (counting.load(std::memory_order_relaxed)) allocations.fetch_add(1);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+TEST_CASE("Controller::step allocates nothing", "[core][mppi]") {
+  mppi::ControllerOptions o;
+  o.num_samples = 500;
+  o.horizon = 30;
+  o.iterations = 2;
+  o.smoothing_window = 5;
+  o.noise_std = {0.5f};
+  o.control_min = {-5.f};
+  o.control_max = {5.f};
+  o.safe_control = {0.f};
+  o.num_threads = 2;
+  auto controller =
+      mppi::make_cpu_controller(mppi::test::DoubleIntegrator{}, mppi::test::QuadraticCost{}, o);
+  const float x0[2] = {1.f, 0.f};
+  mppi::StepSummary summary;
+  controller.step(x0, &summary);  // warm-up: the OpenMP runtime sets up its threads
+  allocations = 0;
+  counting = true;
+  for (int i = 0; i < 20; ++i) controller.step(x0, &summary);
+  const float bad[2] = {NAN, 0.f};
+  controller.step(bad, &summary);
+  counting = false;
+  CHECK(allocations.load() == 0);
+  // The counter works: a vector allocation is seen.
+  counting = true;
+  std::vector<float> v(10);
+  counting = false;
+  CHECK(allocations.load() >= 1);
+}
