@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "mppi/error.hpp"
+#include "mppi/yaml_number.hpp"
 
 namespace mppi {
 
@@ -32,10 +33,7 @@ const std::pair<const char*, FloatField> kFields[] = {
 };
 
 // "file:line:column" (1-based) of a node, or just "file" when yaml-cpp has no position.
-std::string where(const std::string& source, const YAML::Mark& mark) {
-  if (mark.is_null()) return source;
-  return source + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
-}
+std::string where(const std::string& source, const YAML::Mark& mark) { return yaml_where(source, mark); }
 
 std::string known_keys() {
   std::string out;
@@ -60,16 +58,7 @@ AutoRallyCostParams from_node(const YAML::Node& root, const std::string& source)
     if (!field)
       throw Error(at + ": unknown key '" + key + "' in AutoRally cost parameters (known: " + known_keys() + ")");
     if (!seen.insert(key).second) throw Error(at + ": key '" + key + "' given twice");
-    if (!value.IsScalar())
-      throw Error(where(source, value.Mark()) + ": key '" + key + "' must be a number");
-    double v = 0.0;
-    try {
-      v = value.as<double>();
-    } catch (const YAML::Exception&) {
-      throw Error(where(source, value.Mark()) + ": key '" + key + "' must be a number, got '" +
-                  value.Scalar() + "'");
-    }
-    if (std::isnan(v)) throw Error(where(source, value.Mark()) + ": key '" + key + "' is NaN");
+    const double v = yaml_number(value, key, source, /*allow_infinite=*/true);
     params.*field = static_cast<float>(v);
     std::string why;
     // Check each value where it is read so that the message can point at its line.

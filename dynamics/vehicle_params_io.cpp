@@ -11,6 +11,7 @@
 
 #include "dynamics/vehicle_params.hpp"
 #include "mppi/error.hpp"
+#include "mppi/yaml_number.hpp"
 
 namespace mppi {
 
@@ -22,10 +23,7 @@ struct Field {
 };
 
 // "file:line:column" (1-based) of a node, or just "file" when yaml-cpp has no position.
-std::string where(const std::string& source, const YAML::Mark& mark) {
-  if (mark.is_null()) return source;
-  return source + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
-}
+std::string where(const std::string& source, const YAML::Mark& mark) { return yaml_where(source, mark); }
 
 std::string key_list(const std::vector<Field>& fields, const char* extra = nullptr) {
   std::string out;
@@ -35,16 +33,7 @@ std::string key_list(const std::vector<Field>& fields, const char* extra = nullp
 }
 
 double read_number(const YAML::Node& value, const std::string& key, const std::string& source) {
-  if (!value.IsScalar()) throw Error(where(source, value.Mark()) + ": key '" + key + "' must be a number");
-  double v = 0.0;
-  try {
-    v = value.as<double>();
-  } catch (const YAML::Exception&) {
-    throw Error(where(source, value.Mark()) + ": key '" + key + "' must be a number, got '" +
-                value.Scalar() + "'");
-  }
-  if (!std::isfinite(v)) throw Error(where(source, value.Mark()) + ": key '" + key + "' must be finite");
-  return v;
+  return yaml_number(value, key, source);
 }
 
 // Reads a map of key: number into `fields`. `nested_key`/`nested` (optional) handle one
