@@ -5,17 +5,11 @@
 
 #include "costs/cost_config.hpp"
 #include "mppi/error.hpp"
+#include "error_of.hpp"
 #include "test_data.hpp"
 
 namespace {
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const mppi::Error& e) {
-    return e.what();
-  }
-  return "(no mppi::Error thrown)";
-}
+using mppi::test::error_of;
 }  // namespace
 
 TEST_CASE("Cost config: the shipped YAML holds the struct defaults", "[costs]") {

@@ -13,6 +13,7 @@
 #include "costs/cost_map.hpp"
 #include "dynamics/npz.hpp"
 #include "mppi/error.hpp"
+#include "error_of.hpp"
 #include "test_data.hpp"
 
 namespace {
@@ -84,14 +85,7 @@ mppi::CostMap index_map() {
   return mppi::CostMap(-1.f, 2.f, 0.5f, 2.5f, 4.f, v);
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const mppi::Error& e) {
-    return e.what();
-  }
-  return "(no mppi::Error thrown)";
-}
+using mppi::test::error_of;
 
 }  // namespace
 
