@@ -1,13 +1,10 @@
 #include "sim/closed_loop.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
-#include <numbers>
-#include <optional>
 #include <vector>
 
 #include "costs/autorally_cost.hpp"
@@ -155,7 +152,6 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   bool in_contact = false;
   double t = 0.0;
   int reported_laps = 0;
-  double last_lap_end = 0.0;
   StepSummary step_summary;
   while (t < max_time && laps.laps_completed() < config.laps) {
     setup.observe(plant.state(), P::kNx, model_x.data());
@@ -211,10 +207,8 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
       std::fprintf(stderr, "lap %d/%d: %.2f s (mean %.2f m/s), crashes so far %d, t = %.1f s\n",
                    reported_laps, config.laps, lap_time, track.length_m() / lap_time,
                    summary.crashes, t);
-      last_lap_end = t;
     }
   }
-  (void)last_lap_end;
   summary.sim_time_s = t;
   summary.laps_completed = laps.laps_completed();
   summary.lap_times_s = laps.lap_times_s();
