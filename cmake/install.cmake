@@ -2,13 +2,13 @@
 # package so that an out-of-tree project can do find_package(mppi) and link mppi::core etc.
 include(CMakePackageConfigHelpers)
 
-foreach(folder IN ITEMS mppi dynamics costs sim)
+foreach(folder IN ITEMS mppi dynamics costs sim chassis)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${folder}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/${folder}
           FILES_MATCHING PATTERN "*.hpp")
 endforeach()
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/data/ DESTINATION ${CMAKE_INSTALL_DATADIR}/mppi/data)
 
-install(TARGETS mppi_core mppi_io mppi_sim mppi_warnings EXPORT mppiTargets
+install(TARGETS mppi_core mppi_io mppi_sim mppi_chassis mppi_warnings EXPORT mppiTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})

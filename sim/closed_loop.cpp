@@ -5,8 +5,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <vector>
 
+#include "chassis/sim_adapter.hpp"
 #include "costs/autorally_cost.hpp"
 #include "costs/cost_config.hpp"
 #include "costs/cost_map.hpp"
@@ -153,10 +155,16 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   double t = 0.0;
   int reported_laps = 0;
   StepSummary step_summary;
+  std::optional<chassis::SimChassis> chassis;
+  if (config.through_chassis) chassis.emplace();
   while (t < max_time && laps.laps_completed() < config.laps) {
     setup.observe(plant.state(), P::kNx, model_x.data());
     const auto u = controller.step(model_x, &step_summary);
-    const Control command{u[control::kSteer], u[control::kThrottle]};
+    // As on the real car, the controller's output reaches the plant through the chassis
+    // interface (command validation, priorities, runstop, watchdog, calibration to pulse
+    // widths and back through the simulated servos); through_chassis = false bypasses it.
+    const Control output{u[control::kSteer], u[control::kThrottle]};
+    const Control command = chassis ? chassis->drive(output, t) : output;
     optimizer_ms.push_back(step_summary.optimizer_ms);
     ess.push_back(step_summary.effective_sample_size);
     for (int i = 0; i < substeps; ++i) {

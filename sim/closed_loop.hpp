@@ -31,6 +31,8 @@ struct ClosedLoopConfig {
   double plant_dt_s = 0.002;              // plant integration step (500 Hz)
   std::string out_dir;                    // log.csv, track.png, summary.json; empty = none
   bool progress = true;                   // print a line per lap to stderr
+  bool through_chassis = true;            // controller -> chassis adapter (priorities, runstop,
+                                          // watchdog, calibration) -> plant; false = direct
 };
 
 // Runs the loop; throws mppi::Error for bad settings or data files.
