@@ -1,0 +1,123 @@
+#pragma once
+// The UDP adapter: a stack in any language drives the chassis with the messages of
+// udp_protocol.hpp. The vehicle end (UdpChassisServer) drains its socket without blocking on
+// each chassis tick, hands well-formed, fresh, valid messages to the arbiter and counts every
+// rejected datagram by reason; rejected datagrams never reach the arbiter, so they cannot move
+// the car. It answers each client that sent an accepted message in the last second with state
+// messages. The stack end is UdpChassisClient. Loopback by default: there is no
+// authentication, the checksum only catches corruption, not forgery.
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <netinet/in.h>
+
+#include "chassis/arbiter.hpp"
+#include "chassis/udp_protocol.hpp"
+
+namespace mppi::chassis::udp {
+
+struct Counters {
+  long received = 0;
+  long commands_accepted = 0;
+  long runstops_accepted = 0;
+  std::array<long, kRejectCount> rejected{};  // by Reject
+  long total_rejected() const;
+};
+
+// The checks after decoding: message type, sender, replay, content; then the arbiter.
+class PacketFilter {
+ public:
+  explicit PacketFilter(std::size_t max_senders = 64) : max_senders_(max_senders) {}
+  // One datagram of `datagram_size` bytes on the wire (bytes may hold fewer if truncated).
+  Reject handle(std::span<const std::uint8_t> bytes, std::size_t datagram_size, Arbiter& arbiter,
+                Time now);
+  const Counters& counters() const { return counters_; }
+
+ private:
+  Reject count(Reject r);
+  std::size_t max_senders_;
+  std::vector<std::pair<std::string, std::uint64_t>> last_sequence_;
+  Counters counters_;
+};
+
+// A UDP socket (IPv4), closed on destruction.
+class Socket {
+ public:
+  Socket(const std::string& bind_address, int port);  // port 0 = any free port; throws mppi::Error
+  ~Socket();
+  Socket(const Socket&) = delete;
+  Socket& operator=(const Socket&) = delete;
+  int port() const;
+  int fd() const { return fd_; }
+  // Receives one datagram without blocking; returns its full size on the wire (-1 if none).
+  long receive(std::span<std::uint8_t> buffer, sockaddr_in* from);
+  // Waits up to timeout_s for a datagram to arrive; true if one is ready.
+  bool wait_readable(double timeout_s);
+  bool send_to(std::span<const std::uint8_t> bytes, const sockaddr_in& to);
+
+ private:
+  int fd_ = -1;
+};
+
+struct ServerSettings {
+  std::string bind_address = "127.0.0.1";  // loopback only by default
+  int port = kDefaultPort;                 // 0 = any free port
+  std::size_t max_senders = 64;            // replay table size
+  int max_datagrams_per_poll = 256;        // bound on work per chassis tick
+  double client_timeout_s = 1.0;           // state goes to clients heard from this recently
+};
+
+class UdpChassisServer {
+ public:
+  explicit UdpChassisServer(ServerSettings settings = {});
+  int port() const { return socket_.port(); }
+  // Drains pending datagrams (never blocks) into the arbiter; returns how many were read.
+  int poll(Arbiter& arbiter, Time now);
+  // Sends a state message to every recent client.
+  void send_state(const StateMessage& state, Time now);
+  const Counters& counters() const { return filter_.counters(); }
+
+ private:
+  struct Client {
+    sockaddr_in address;
+    Time last_heard;
+  };
+  ServerSettings settings_;
+  Socket socket_;
+  PacketFilter filter_;
+  std::vector<Client> clients_;
+  std::uint64_t state_sequence_;
+};
+
+class UdpChassisClient {
+ public:
+  // `sender` signs every message (controller name in the priorities, or runstop source).
+  // The first sequence number defaults to the wall clock in microseconds, so a restarted
+  // client continues above its previous numbers.
+  UdpChassisClient(std::string sender, const std::string& host = "127.0.0.1",
+                   int port = kDefaultPort, std::optional<std::uint64_t> first_sequence = {});
+  void send_command(const Command& command);
+  void send_runstop(bool motion_enabled);
+  // Sends raw bytes (tests of malformed datagrams).
+  void send_raw(std::span<const std::uint8_t> bytes);
+  // The next valid state message within timeout_s, if any.
+  std::optional<StateMessage> receive_state(double timeout_s);
+  std::uint64_t next_sequence() const { return sequence_; }
+  long rejected_replies() const { return rejected_; }
+
+ private:
+  std::string sender_;
+  Socket socket_;
+  sockaddr_in server_{};
+  std::uint64_t sequence_;
+  std::uint64_t last_state_sequence_ = 0;
+  bool have_state_ = false;
+  long rejected_ = 0;
+};
+
+}  // namespace mppi::chassis::udp
