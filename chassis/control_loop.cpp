@@ -19,22 +19,28 @@ bool ControlLoopSettings::is_valid(std::string* why) const {
 }
 
 ControlLoop::ControlLoop(ControlLoopSettings settings, Clock& clock, StateSource state,
-                         Policy policy, CommandMailbox& out)
+                         Policy policy, Publisher publish)
     : settings_(settings), clock_(clock), state_source_(std::move(state)),
-      policy_(std::move(policy)), out_(out), period_(seconds(1.0 / settings.rate_hz)),
+      policy_(std::move(policy)), publish_(std::move(publish)), period_(seconds(1.0 / settings.rate_hz)),
       state_(static_cast<std::size_t>(std::max(1, settings.state_size))),
       recorder_(1000.0 / settings.rate_hz, settings.stats_window) {
   std::string why;
   if (!settings_.is_valid(&why)) throw Error("control loop: " + why);
-  if (!state_source_ || !policy_) throw Error("control loop: state source and policy are required");
+  if (!state_source_ || !policy_ || !publish_)
+    throw Error("control loop: state source, policy and publisher are required");
 }
+
+ControlLoop::ControlLoop(ControlLoopSettings settings, Clock& clock, StateSource state,
+                         Policy policy, CommandMailbox& out)
+    : ControlLoop(settings, clock, std::move(state), std::move(policy),
+                  [&out](const Command& c, Time ready) { out.put({c, ready}); }) {}
 
 void ControlLoop::run(const std::atomic<bool>& stop, long max_ticks) {
   Time release = clock_.now();
   for (long n = 0; !stop.load(std::memory_order_relaxed) && (max_ticks < 0 || n < max_ticks); ++n) {
     if (state_source_(state_)) {
       const Command c = policy_(state_);
-      out_.put({c, clock_.now()});
+      publish_(c, clock_.now());
     } else {
       ++no_state_;
     }

@@ -34,6 +34,13 @@ class ControlLoop {
   // The controller: state -> command.
   using Policy = std::function<Command(std::span<const float> state)>;
 
+  // Where each command goes, with the time it was ready; must not block for long (a mailbox
+  // put, a UDP send).
+  using Publisher = std::function<void(const Command& command, Time ready)>;
+
+  ControlLoop(ControlLoopSettings settings, Clock& clock, StateSource state, Policy policy,
+              Publisher publish);
+  // Publishes into a mailbox that a ChassisLoop polls.
   ControlLoop(ControlLoopSettings settings, Clock& clock, StateSource state, Policy policy,
               CommandMailbox& out);
 
@@ -47,7 +54,7 @@ class ControlLoop {
   Clock& clock_;
   StateSource state_source_;
   Policy policy_;
-  CommandMailbox& out_;
+  Publisher publish_;
   Duration period_;
   std::vector<float> state_;
   DeadlineRecorder recorder_;

@@ -1,1 +1,167 @@
-int main() { return 0; }
+// mppi-udp-bridge: the vehicle end of the UDP chassis interface, in front of a simulated car.
+// A stack in any language sends command and runstop datagrams (docs/CHASSIS.md) to
+// 127.0.0.1:47800; the bridge runs the chassis at a fixed rate (priorities, runstop, watchdog,
+// calibration to pulse widths), drives the built-in single-track car with the pulse widths in
+// real time and answers every client with state datagrams. On exit it prints the datagram
+// counters by rejection reason and the chassis loop's deadline statistics.
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "chassis/chassis.hpp"
+#include "chassis/udp_adapter.hpp"
+#include "dynamics/single_track.hpp"
+#include "dynamics/vehicle_params.hpp"
+#include "mppi/error.hpp"
+#include "sim/data_dir.hpp"
+#include "sim/lap_counter.hpp"
+#include "sim/plant.hpp"
+#include "sim/track.hpp"
+
+namespace {
+
+constexpr const char* kUsage = R"(usage: mppi-udp-bridge [options]
+  --bind ADDR          IPv4 address to listen on                (127.0.0.1: loopback only)
+  --port N             UDP port                                  (47800)
+  --rate HZ            chassis rate                              (100)
+  --calibration FILE   chassis calibration YAML                  (data/config/chassis_calibration.yaml)
+  --priorities FILE    controller priorities YAML                (data/config/chassis_priorities.yaml)
+  --stop-throttle V    throttle while stopped, in [-1, 0]        (0: neutral)
+  --track NAME         track the simulated car starts on         (gazebo)
+  --duration S         stop after S seconds; 0 = until Ctrl-C    (0)
+  --quiet              no status line per second
+)";
+
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop = true; }
+
+[[noreturn]] void usage_error(const std::string& msg) {
+  std::fprintf(stderr, "mppi-udp-bridge: %s\n%s", msg.c_str(), kUsage);
+  std::exit(2);
+}
+
+double number(const std::string& flag, const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0') usage_error(flag + " expects a number, got '" + text + "'");
+  return v;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace mppi;
+  using namespace mppi::chassis;
+  std::string bind = "127.0.0.1", calibration_file, priorities_file, track_name = "gazebo";
+  int port = udp::kDefaultPort;
+  double rate_hz = 100.0, duration_s = 0.0;
+  bool quiet = false;
+  SafetySettings safety;
+  for (int i = 1; i < argc; ++i) {
+    const std::string flag = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usage_error(flag + " needs a value");
+      return argv[++i];
+    };
+    if (flag == "--help" || flag == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (flag == "--bind") bind = value();
+    else if (flag == "--port") port = static_cast<int>(number(flag, value()));
+    else if (flag == "--rate") rate_hz = number(flag, value());
+    else if (flag == "--calibration") calibration_file = value();
+    else if (flag == "--priorities") priorities_file = value();
+    else if (flag == "--stop-throttle") safety.stop_throttle = static_cast<float>(number(flag, value()));
+    else if (flag == "--track") track_name = value();
+    else if (flag == "--duration") duration_s = number(flag, value());
+    else if (flag == "--quiet") quiet = true;
+    else usage_error("unknown option " + flag);
+  }
+  try {
+    const Calibration calibration = Calibration::load_yaml(
+        calibration_file.empty() ? sim::data_file("config/chassis_calibration.yaml") : calibration_file);
+    Priorities priorities = Priorities::load_yaml(
+        priorities_file.empty() ? sim::data_file("config/chassis_priorities.yaml") : priorities_file);
+    Chassis chassis(priorities, calibration, safety);
+    udp::ServerSettings server_settings;
+    server_settings.bind_address = bind;
+    server_settings.port = port;
+    udp::UdpChassisServer server(server_settings);
+
+    // The simulated car: AutoRally's single-track model on the track's start line.
+    const sim::Track track = sim::Track::load(track_name);
+    sim::Plant<SingleTrack> plant(
+        SingleTrack(load_single_track_params(sim::data_file("config/autorally_single_track.yaml"))));
+    const sim::Pose2 start = track.start_pose();
+    VehicleState s0;
+    s0.x_m = static_cast<float>(start.x_m);
+    s0.y_m = static_cast<float>(start.y_m);
+    s0.yaw_rad = static_cast<float>(start.yaw_rad);
+    plant.reset(s0);
+    sim::LapCounter laps(track);
+    laps.reset({start.x_m, start.y_m}, 0.0);
+
+    SteadyClock clock;
+    const Time t0 = clock.now();
+    ChassisLoop loop(chassis, clock, rate_hz);
+    loop.add_input([&](Arbiter& a, Time now) { server.poll(a, now); });
+    const float period_s = static_cast<float>(1.0 / rate_hz);
+    Time next_status = t0 + seconds(1.0);
+    loop.set_sink([&](const ChassisOutput& out) {
+      // The link carries whole microseconds; the simulated servos read them back.
+      const PulseWidths pulses = out.pulses.rounded();
+      const Command applied = calibration.values(pulses);
+      plant.advance(Control{applied.steering, applied.throttle}, period_s);
+      const double t = to_seconds(out.time - t0);
+      const VehicleState s = plant.vehicle_state();
+      laps.update({s.x_m, s.y_m}, t);
+      udp::StateMessage msg;
+      msg.time_s = t;
+      msg.state = s.to_array();
+      msg.applied = {applied.steering, applied.throttle, applied.front_brake};
+      msg.pulses_us = {static_cast<std::uint16_t>(pulses.steering_us),
+                       static_cast<std::uint16_t>(pulses.throttle_us),
+                       static_cast<std::uint16_t>(pulses.front_brake_us)};
+      msg.motion_enabled = out.decision.motion_enabled;
+      msg.watchdog_tripped = out.decision.watchdog_tripped;
+      server.send_state(msg, out.time);
+      if (!quiet && out.time >= next_status) {
+        next_status += seconds(1.0);
+        const Arbiter& a = chassis.arbiter();
+        std::fprintf(stderr,
+                     "t %6.1f s | steer %-9s %4.0f us | throttle %-9s %4.0f us | brake %4.0f us | "
+                     "%s | v %4.1f m/s | laps %d | rx %ld, rejected %ld\n",
+                     t, std::string(a.commander_name(out.decision.steering_commander)).c_str(),
+                     pulses.steering_us,
+                     std::string(a.commander_name(out.decision.throttle_commander)).c_str(),
+                     pulses.throttle_us, pulses.front_brake_us,
+                     out.decision.motion_enabled ? "motion enabled" : "RUNSTOP", s.vx_mps,
+                     laps.laps_completed(), server.counters().received,
+                     server.counters().total_rejected());
+      }
+    });
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+    std::fprintf(stderr, "mppi-udp-bridge: listening on %s:%d, chassis at %.0f Hz, %d controllers\n",
+                 bind.c_str(), server.port(), rate_hz, priorities.size());
+    loop.run(g_stop, duration_s > 0 ? static_cast<long>(duration_s * rate_hz) : -1);
+
+    const auto& c = server.counters();
+    std::printf("datagrams received %ld: commands accepted %ld, runstops accepted %ld, rejected %ld\n",
+                c.received, c.commands_accepted, c.runstops_accepted, c.total_rejected());
+    for (int r = 1; r < udp::kRejectCount; ++r)
+      if (c.rejected[static_cast<std::size_t>(r)])
+        std::printf("  rejected, %s: %ld\n", udp::to_string(static_cast<udp::Reject>(r)),
+                    c.rejected[static_cast<std::size_t>(r)]);
+    std::printf("chassis loop: %s\n", loop.stats().to_string().c_str());
+    std::printf("laps %d", laps.laps_completed());
+    for (double lt : laps.lap_times_s()) std::printf(" %.2f", lt);
+    std::printf("\n");
+  } catch (const Error& e) {
+    std::fprintf(stderr, "mppi-udp-bridge: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

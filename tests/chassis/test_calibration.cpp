@@ -127,3 +127,13 @@ TEST_CASE("AutoRally's priority file loads best first; ties and junk are rejecte
   CHECK_THAT(error_of([] { Priorities::parse_yaml("a: -1\n", "v.yaml"); }),
              Catch::Contains("v.yaml:1:4"));
 }
+
+TEST_CASE("the shipped chassis configuration files load", "[chassis][calibration]") {
+  const std::string dir = MPPI_TEST_DATA_DIR;
+  const auto cal = Calibration::load_yaml(dir + "/config/chassis_calibration.yaml");
+  CHECK(cal.steering.center_us == 1500);
+  CHECK(cal.front_brake.min_us == 1500);
+  const auto p = Priorities::load_yaml(dir + "/config/chassis_priorities.yaml");
+  CHECK(p.entries().front().sender == "mppi");
+  for (const auto& e : p.entries()) CHECK(e.sender.size() <= 15);  // fits the UDP sender field
+}

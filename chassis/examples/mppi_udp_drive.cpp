@@ -1,0 +1,175 @@
+// mppi-udp-drive: the stack end of the UDP chassis interface, in C++. It runs MPPI (AutoRally's
+// network, or the kinematic bicycle) in the control-loop runner at a fixed rate on the state
+// datagrams of a chassis (mppi-udp-bridge, or any program speaking docs/CHASSIS.md), sends the
+// commands as controller `--name` and, as the operator station `--runstop-name`, a runstop
+// message allowing motion. On exit it prints the runner's deadline statistics.
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "chassis/control_loop.hpp"
+#include "chassis/udp_adapter.hpp"
+#include "costs/autorally_cost.hpp"
+#include "costs/cost_config.hpp"
+#include "costs/cost_map.hpp"
+#include "dynamics/autorally_nn.hpp"
+#include "dynamics/kinematic_bicycle.hpp"
+#include "mppi/controller.hpp"
+#include "mppi/error.hpp"
+#include "sim/data_dir.hpp"
+#include "sim/lap_counter.hpp"
+#include "sim/track.hpp"
+
+namespace {
+
+constexpr const char* kUsage = R"(usage: mppi-udp-drive [options]
+  --host ADDR          chassis address                          (127.0.0.1)
+  --port N             chassis UDP port                         (47800)
+  --name NAME          controller name in the priorities        (mppi)
+  --runstop-name NAME  runstop source name                      (OCS)
+  --model NAME         autorally-nn | kinematic                 (autorally-nn)
+  --track NAME         track of the cost map                    (gazebo)
+  --speed MPS          target speed                             (6)
+  --rate HZ            controller rate                          (50)
+  --samples K          MPPI samples                             (1920)
+  --horizon T          MPPI time steps                          (100)
+  --threads N          CPU threads, 0 = all                     (0)
+  --seed N             noise seed                               (1)
+  --duration S         stop after S seconds; 0 = until Ctrl-C   (30)
+)";
+
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop = true; }
+
+[[noreturn]] void usage_error(const std::string& msg) {
+  std::fprintf(stderr, "mppi-udp-drive: %s\n%s", msg.c_str(), kUsage);
+  std::exit(2);
+}
+double number(const std::string& flag, const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0') usage_error(flag + " expects a number, got '" + text + "'");
+  return v;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace mppi;
+  using namespace mppi::chassis;
+  std::string host = "127.0.0.1", name = "mppi", runstop_name = "OCS", model = "autorally-nn",
+              track_name = "gazebo";
+  int port = udp::kDefaultPort;
+  double speed = 6.0, duration_s = 30.0;
+  ControlLoopSettings loop_settings;
+  ControllerOptions options;
+  for (int i = 1; i < argc; ++i) {
+    const std::string flag = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usage_error(flag + " needs a value");
+      return argv[++i];
+    };
+    if (flag == "--help" || flag == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (flag == "--host") host = value();
+    else if (flag == "--port") port = static_cast<int>(number(flag, value()));
+    else if (flag == "--name") name = value();
+    else if (flag == "--runstop-name") runstop_name = value();
+    else if (flag == "--model") model = value();
+    else if (flag == "--track") track_name = value();
+    else if (flag == "--speed") speed = number(flag, value());
+    else if (flag == "--rate") loop_settings.rate_hz = number(flag, value());
+    else if (flag == "--samples") options.num_samples = static_cast<int>(number(flag, value()));
+    else if (flag == "--horizon") options.horizon = static_cast<int>(number(flag, value()));
+    else if (flag == "--threads") options.num_threads = static_cast<int>(number(flag, value()));
+    else if (flag == "--seed") options.seed = static_cast<std::uint64_t>(number(flag, value()));
+    else if (flag == "--duration") duration_s = number(flag, value());
+    else usage_error("unknown option " + flag);
+  }
+  try {
+    const sim::Track track = sim::Track::load(track_name);
+    AutoRallyCostParams cost_params = load_autorally_cost_params(sim::data_file("config/autorally_cost.yaml"));
+    cost_params.target_speed_mps = static_cast<float>(speed);
+    const AutoRallyCost cost(std::make_shared<const CostMap>(CostMap::load_npz(track.costmap_path())),
+                             cost_params);
+    std::unique_ptr<Controller> controller;
+    bool rear_axle = false;  // the kinematic bicycle's reference point is the rear axle
+    if (model == "autorally-nn") {
+      controller = std::make_unique<Controller>(make_cpu_controller(
+          AutoRallyNetwork::load(sim::data_file("autorally/models/autorally_nnet_09_12_2018.npz")), cost,
+          options));
+    } else if (model == "kinematic") {
+      controller = std::make_unique<Controller>(make_cpu_controller(KinematicBicycle(), cost, options));
+      rear_axle = true;
+    } else {
+      usage_error("unknown model '" + model + "'");
+    }
+    const float l_r = static_cast<float>(SingleTrackParams{}.cg_to_rear_axle_m);
+
+    udp::UdpChassisClient commands(name, host, port);
+    udp::UdpChassisClient runstop(runstop_name, host, port);
+    runstop.send_runstop(true);  // announce ourselves, so the chassis starts sending state
+    commands.send_command(Command{});  // a neutral command: the chassis answers clients it heard
+
+    // A receiver thread keeps the latest state in a mailbox; the loop never waits for it.
+    Mailbox<udp::StateMessage> latest;
+    std::atomic<bool> stop_rx{false};
+    std::thread receiver([&] {
+      while (!stop_rx) {
+        if (auto s = commands.receive_state(0.05)) latest.put(*s);
+      }
+    });
+    std::uint64_t seen = 0;
+    udp::StateMessage state_msg;
+    bool have_state = false;
+    sim::LapCounter laps(track);
+    bool laps_started = false;
+    SteadyClock clock;
+    ControlLoop loop(
+        loop_settings, clock,
+        [&](std::span<float> x) {
+          runstop.send_runstop(true);  // the operator's heartbeat, every tick
+          if (latest.try_take(&state_msg, &seen)) have_state = true;
+          if (!have_state) return false;
+          std::copy(state_msg.state.begin(), state_msg.state.end(), x.begin());
+          if (!laps_started) laps.reset({x[0], x[1]}, state_msg.time_s), laps_started = true;
+          laps.update({x[0], x[1]}, state_msg.time_s);
+          if (rear_axle) {
+            x[state::kX] -= l_r * std::cos(x[state::kYaw]);
+            x[state::kY] -= l_r * std::sin(x[state::kYaw]);
+            x[state::kVy] = 0.f;
+          }
+          return true;
+        },
+        [&](std::span<const float> x) {
+          const auto u = controller->step(x);
+          return Command{u[control::kSteer], u[control::kThrottle], 0.f, actuator::kAll};
+        },
+        [&](const Command& c, Time) {
+          commands.send_command(c);
+        });
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+    std::fprintf(stderr, "mppi-udp-drive: %s MPPI (K = %d, T = %d) at %.0f Hz -> %s:%d as '%s'\n",
+                 model.c_str(), options.num_samples, options.horizon, loop_settings.rate_hz,
+                 host.c_str(), port, name.c_str());
+    loop.run(g_stop, duration_s > 0 ? static_cast<long>(duration_s * loop_settings.rate_hz) : -1);
+    runstop.send_runstop(false);  // leave the car stopped
+    stop_rx = true;
+    receiver.join();
+    std::printf("control loop: %s\n", loop.stats().to_string().c_str());
+    std::printf("ticks without state: %ld\n", loop.ticks_without_state());
+    std::printf("laps %d", laps.laps_completed());
+    for (double lt : laps.lap_times_s()) std::printf(" %.2f", lt);
+    std::printf("\n");
+  } catch (const Error& e) {
+    std::fprintf(stderr, "mppi-udp-drive: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
