@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <thread>
 
 #include "chassis/chassis.hpp"
 #include "chassis/udp_adapter.hpp"
@@ -146,7 +147,15 @@ int main(int argc, char** argv) {
     std::signal(SIGTERM, on_signal);
     std::fprintf(stderr, "mppi-udp-bridge: listening on %s:%d, chassis at %.0f Hz, %d controllers\n",
                  bind.c_str(), server.port(), rate_hz, priorities.size());
-    loop.run(g_stop, duration_s > 0 ? static_cast<long>(duration_s * rate_hz) : -1);
+    std::thread timer([&] {  // --duration is wall-clock time
+      const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration_s);
+      while (duration_s > 0 && !g_stop && std::chrono::steady_clock::now() < end)
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      if (duration_s > 0) g_stop = true;
+    });
+    loop.run(g_stop);
+    g_stop = true;
+    timer.join();
 
     const auto& c = server.counters();
     std::printf("datagrams received %ld: commands accepted %ld, runstops accepted %ld, rejected %ld\n",

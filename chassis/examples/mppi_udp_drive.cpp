@@ -125,17 +125,19 @@ int main(int argc, char** argv) {
       }
     });
     std::uint64_t seen = 0;
+    SteadyClock clock;
     udp::StateMessage state_msg;
     bool have_state = false;
+    Time state_at{0};
     sim::LapCounter laps(track);
     bool laps_started = false;
-    SteadyClock clock;
     ControlLoop loop(
         loop_settings, clock,
         [&](std::span<float> x) {
           runstop.send_runstop(true);  // the operator's heartbeat, every tick
-          if (latest.try_take(&state_msg, &seen)) have_state = true;
-          if (!have_state) return false;
+          if (latest.try_take(&state_msg, &seen)) have_state = true, state_at = clock.now();
+          // No state, or none for 0.1 s (the chassis is gone): publish nothing this tick.
+          if (!have_state || clock.now() - state_at > seconds(0.1)) return false;
           std::copy(state_msg.state.begin(), state_msg.state.end(), x.begin());
           if (!laps_started) laps.reset({x[0], x[1]}, state_msg.time_s), laps_started = true;
           laps.update({x[0], x[1]}, state_msg.time_s);
@@ -158,7 +160,15 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "mppi-udp-drive: %s MPPI (K = %d, T = %d) at %.0f Hz -> %s:%d as '%s'\n",
                  model.c_str(), options.num_samples, options.horizon, loop_settings.rate_hz,
                  host.c_str(), port, name.c_str());
-    loop.run(g_stop, duration_s > 0 ? static_cast<long>(duration_s * loop_settings.rate_hz) : -1);
+    std::thread timer([&] {  // --duration is wall-clock time
+      const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration_s);
+      while (duration_s > 0 && !g_stop && std::chrono::steady_clock::now() < end)
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      if (duration_s > 0) g_stop = true;
+    });
+    loop.run(g_stop);
+    g_stop = true;
+    timer.join();
     runstop.send_runstop(false);  // leave the car stopped
     stop_rx = true;
     receiver.join();
