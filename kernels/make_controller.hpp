@@ -8,6 +8,7 @@
 // MPPI_VULKAN_DEVICE=<index or part of the name> picks the Vulkan device (for auto too).
 // GPU twins exist for KinematicBicycle, AutoRallyNetwork (3 layers tanh-tanh-linear) and
 // SingleTrack under AutoRallyCost; any other model or cost runs on the CPU.
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <type_traits>
@@ -74,11 +75,13 @@ Controller make_controller(D model, C cost, const ControllerOptions& options,
     if (backend) {
       const auto* vk = static_cast<const vulkan::VulkanBackend*>(backend.get());
       r.backend = "vulkan";
-      r.reason = choice == BackendChoice::kAuto
-                     ? "auto: a GPU Vulkan device was found"
-                     : (vk->device_is_cpu() ? "asked for Vulkan; the device is a CPU implementation "
-                                              "(lavapipe): correct but slower than the CPU backend"
-                                            : "asked for Vulkan");
+      const char* env = std::getenv("MPPI_VULKAN_DEVICE");
+      r.reason = std::string(choice == BackendChoice::kAuto ? "auto" : "asked for Vulkan") +
+                 (env && *env ? std::string(": MPPI_VULKAN_DEVICE=") + env + " picked the device"
+                              : std::string(": the best Vulkan device")) +
+                 (vk->device_is_cpu() ? "; it is a CPU implementation (e.g. lavapipe): correct but "
+                                        "slower than the CPU backend"
+                                      : "");
       return Controller(std::move(backend), options);
     }
     r.reason = std::string(choice == BackendChoice::kAuto ? "auto" : "asked for Vulkan, falling back") +

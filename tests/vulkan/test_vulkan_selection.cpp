@@ -2,6 +2,7 @@
 // when asked for; MPPI_VULKAN_DEVICE picks one), and the fallbacks that must never crash.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <cstdlib>
 #include <memory>
 #include <string>
@@ -134,4 +135,23 @@ TEST_CASE("make_controller reports the backend it chose and falls back to the CP
   CHECK(r.backend == "vulkan");
   CHECK(!r.device.empty());
   CHECK(std::string(v.backend().name()) == "vulkan");
+}
+
+TEST_CASE("no Vulkan driver: a clear reason and the CPU backend, not a crash", "[vulkan][selection]") {
+  // The loader reads these at instance creation: pointing them at nothing leaves no driver.
+  const ScopedEnv icd("VK_ICD_FILENAMES", "/nonexistent/mppi_no_icd.json");
+  const ScopedEnv drivers("VK_DRIVER_FILES", "/nonexistent/mppi_no_icd.json");
+  const mppi::vulkan::Probe p = mppi::vulkan::probe();
+  CHECK_FALSE(p.available);
+  CHECK(!p.error.empty());
+  mppi::ControllerOptions o;
+  o.num_samples = 64;
+  o.horizon = 10;
+  mppi::BackendReport r;
+  auto c = mppi::make_controller(mppi::KinematicBicycle{}, mppi::AutoRallyCost(flat_map()), o,
+                                 mppi::BackendChoice::kVulkan, &r);
+  CHECK(r.backend == "cpu");
+  CHECK_THAT(r.reason, Catch::Contains("falling back") && Catch::Contains(p.error));
+  const float x0[7] = {0, 0, 0, 1, 0, 0, 0};
+  CHECK(std::isfinite(c.step(x0)[0]));
 }
