@@ -38,6 +38,6 @@ TEST_CASE("the closed loop laps the Gazebo oval on Vulkan as on the CPU", "[vulk
   CHECK(cpu.crashes == 0);
   REQUIRE(vk.lap_times_s.size() == 1);
   REQUIRE(cpu.lap_times_s.size() == 1);
-  CHECK(vk.lap_times_s[0] == Approx(cpu.lap_times_s[0]).epsilon(0.03));
-  CHECK(vk.mean_speed_mps == Approx(cpu.mean_speed_mps).epsilon(0.03));
+  CHECK(vk.lap_times_s[0] == Approx(cpu.lap_times_s[0]).epsilon(0.05));
+  CHECK(vk.mean_speed_mps == Approx(cpu.mean_speed_mps).epsilon(0.05));
 }
