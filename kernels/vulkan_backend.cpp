@@ -97,9 +97,17 @@ std::optional<TwinModel> twin_of(const AutoRallyNetwork& m, std::string* why) {
   t.num_states = AutoRallyNetwork::kNx;
   t.hidden1 = h1;
   t.hidden2 = h2;
+  // Each layer: W with every row padded to a multiple of 4 floats, then b padded to a multiple
+  // of 4 (the layout shaders/model_network.glsl reads 4 weights at a time).
+  auto pad4 = [](int n) { return (n + 3) / 4 * 4; };
   for (const DenseLayer& l : layers) {
-    t.params.insert(t.params.end(), l.weights.begin(), l.weights.end());
+    for (int o = 0; o < l.n_out; ++o) {
+      const auto row = l.weights.begin() + static_cast<std::ptrdiff_t>(o) * l.n_in;
+      t.params.insert(t.params.end(), row, row + l.n_in);
+      t.params.resize(t.params.size() + static_cast<std::size_t>(pad4(l.n_in) - l.n_in), 0.f);
+    }
     t.params.insert(t.params.end(), l.bias.begin(), l.bias.end());
+    t.params.resize(t.params.size() + static_cast<std::size_t>(pad4(l.n_out) - l.n_out), 0.f);
   }
   if (static_cast<int>(t.params.size()) + kCostFloats > kParamFloats)
     return fail("its " + std::to_string(t.params.size()) + " weights do not fit the 16 KiB uniform buffer");
