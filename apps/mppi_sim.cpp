@@ -25,6 +25,9 @@ const char* kUsage = R"(usage: mppi-sim [options]
   --smoothing W        Savitzky-Golay window over the plan, 0 = off  (0)
   --seed N             noise seed                                    (1)
   --threads N          CPU threads, 0 = all                          (0)
+  --backend NAME       auto | cpu | vulkan: auto takes a GPU through Vulkan if
+                       there is one, else the CPU; vulkan also takes a CPU Vulkan
+                       device (lavapipe); MPPI_VULKAN_DEVICE=<index|name> picks one (auto)
   --cost-config FILE   AutoRally cost weights (YAML)
   --plant-params FILE  single-track plant parameters (YAML)
   --model-params FILE  physics controller-model parameters (YAML)
@@ -61,6 +64,7 @@ int parse_int(const std::string& flag, const std::string& text) {
 int main(int argc, char** argv) {
   mppi::sim::ClosedLoopConfig config;
   config.out_dir = "out/sim";
+  config.backend = mppi::BackendChoice::kAuto;
   bool print_json = false;
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
@@ -85,6 +89,13 @@ int main(int argc, char** argv) {
     else if (flag == "--smoothing") config.controller.smoothing_window = parse_int(flag, value());
     else if (flag == "--seed") config.controller.seed = static_cast<std::uint64_t>(parse_int(flag, value()));
     else if (flag == "--threads") config.controller.num_threads = parse_int(flag, value());
+    else if (flag == "--backend") {
+      try {
+        config.backend = mppi::parse_backend_choice(value());
+      } catch (const mppi::Error& e) {
+        usage_error(e.what());
+      }
+    }
     else if (flag == "--cost-config") config.cost_params_yaml = value();
     else if (flag == "--plant-params") config.plant_params_yaml = value();
     else if (flag == "--model-params") config.model_params_yaml = value();

@@ -2,6 +2,7 @@
 // The one coarse virtual boundary of the data path: roll out a batch of control sequences
 // from one start state and return each sequence's total running cost. Behind it, models and
 // costs are templates inlined over structure-of-arrays batches (see cpu_backend.hpp).
+#include <cstdint>
 #include <span>
 
 namespace mppi {
@@ -15,6 +16,29 @@ struct RolloutShape {
   int num_controls = 0;        // model control size
 };
 
+// One whole MPPI iteration done by the backend (a GPU backend: sampling, rollouts and the
+// weighted update without round trips). Inputs as in Controller; see Backend::iterate().
+struct IterationInput {
+  std::span<const float> x0;           // num_states
+  std::span<const float> nominal;      // T x nu, row-major
+  std::span<const float> noise_std;    // nu
+  std::span<const float> control_min;  // nu
+  std::span<const float> control_max;  // nu
+  float gamma = 0.f;                   // control-cost weight
+  float lambda = 1.f;                  // temperature
+  std::uint64_t seed = 0;              // Philox key (the same numbers as the CPU path)
+  std::uint32_t iteration = 0;         // Philox counter word 2
+};
+struct IterationOutput {
+  std::span<float> next;     // T x nu: sum_k w_k V_k (before smoothing)
+  std::span<float> costs;    // padded: total cost S_k of each sample (first K valid)
+  std::span<float> weights;  // padded: normalised weights (first K valid)
+  float min_cost = 0.f;      // min of the finite S_k
+  float mean_cost = 0.f;     // mean of the finite S_k
+  float sum_sq_weights = 0.f;  // sum_k w_k^2
+  int valid_samples = 0;     // samples with a finite S_k (0: next is not usable)
+};
+
 class Backend {
  public:
   virtual ~Backend() = default;
@@ -24,6 +48,13 @@ class Backend {
   // costs: padded_samples, written (entries >= num_samples are unspecified).
   virtual void rollout(std::span<const float> x0, std::span<const float> controls,
                        std::span<float> costs) = 0;
+  // True if iterate() works: then Controller hands each iteration over whole.
+  virtual bool has_iterate() const { return false; }
+  // Samples V_k = clamp(U + eps_k) with the Philox numbers of mppi/noise.hpp, rolls out, and
+  // forms the weights and the weighted sum, as Controller does on the CPU.
+  virtual void iterate(const IterationInput& /*in*/, IterationOutput& /*out*/) {}
+  // The controls sampled by the last iterate() (T x nu x padded), if the backend keeps them.
+  virtual std::span<const float> sampled_controls() const { return {}; }
 };
 
 }  // namespace mppi

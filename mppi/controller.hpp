@@ -125,9 +125,13 @@ class Controller {
     std::copy(x0.begin(), x0.end(), x0_.begin());
     for (int it = 0; it < options_.iterations; ++it) {
       const auto iteration = static_cast<std::uint32_t>(step_index_ * options_.iterations + it);
-      sample(iteration);
-      backend_->rollout(x0_, controls_, costs_);
-      if (!update_nominal(sum)) return safe_output(sum, start);
+      if (backend_->has_iterate()) {
+        if (!device_iteration(iteration, sum)) return safe_output(sum, start);
+      } else {
+        sample(iteration);
+        backend_->rollout(x0_, controls_, costs_);
+        if (!update_nominal(sum)) return safe_output(sum, start);
+      }
       sum.iterations = it + 1;
     }
     std::copy_n(nominal_.begin(), nu_, output_.begin());
@@ -147,7 +151,10 @@ class Controller {
 
   std::span<const float> nominal() const { return nominal_; }  // T x nu, row-major
   // The sampled sequences and costs of the last iteration (T x nu x padded; padded).
-  std::span<const float> sampled_controls() const { return controls_; }
+  // (With a backend that iterates on the device, the backend's copy, or empty if it keeps none.)
+  std::span<const float> sampled_controls() const {
+    return backend_->has_iterate() ? backend_->sampled_controls() : std::span<const float>(controls_);
+  }
   std::span<const float> sampled_costs() const { return std::span(costs_).first(options_.num_samples); }
   std::span<const float> weights() const { return std::span(weights_).first(options_.num_samples); }
   const ControllerOptions& options() const { return options_; }
@@ -205,6 +212,14 @@ class Controller {
     sum.min_cost = min_cost;
     sum.mean_cost = static_cast<float>(cost_sum / valid);
     sum.effective_sample_size = static_cast<float>(1.0 / sum_sq);
+    weighted_sum();
+    commit_next();
+    return true;
+  }
+
+  // U <- sum_k w_k V_k into next_.
+  void weighted_sum() {
+    const int k_count = options_.num_samples;
 
     // U <- sum_k w_k V_k: one row (t, c) per task, summed over k in a fixed order, so the
     // result does not depend on the thread count.
@@ -221,6 +236,43 @@ class Controller {
       for (int k = 0; k < k_count; ++k) acc += w[k] * vr[k];
       next[row] = acc;
     }
+  }
+
+  // The whole iteration on the backend (device noise, rollouts, weights, weighted sum); the
+  // smoothing and clamping stay here. False if no sample has a finite cost.
+  bool device_iteration(std::uint32_t iteration, StepSummary& sum) {
+    IterationInput in;
+    in.x0 = x0_;
+    in.nominal = nominal_;
+    in.noise_std = options_.noise_std;
+    in.control_min = options_.control_min;
+    in.control_max = options_.control_max;
+    in.gamma = options_.gamma;
+    in.lambda = options_.lambda;
+    in.seed = options_.seed;
+    in.iteration = iteration;
+    IterationOutput out;
+    out.next = next_;
+    out.costs = costs_;
+    out.weights = weights_;
+    backend_->iterate(in, out);
+    sum.valid_samples = out.valid_samples;
+    bool usable = out.valid_samples > 0;
+    for (std::size_t i = 0; usable && i < next_.size(); ++i) usable = std::isfinite(next_[i]);
+    if (!usable) {
+      sum.status = StepStatus::kNoValidRollout;
+      sum.reason = "every sampled rollout cost was NaN or infinite";
+      return false;
+    }
+    sum.min_cost = out.min_cost;
+    sum.mean_cost = out.mean_cost;
+    sum.effective_sample_size = 1.f / out.sum_sq_weights;
+    commit_next();
+    return true;
+  }
+
+  // nominal <- next_ (smoothed and clamped if smoothing is on).
+  void commit_next() {
     if (smoother_.enabled()) {
       for (int c = 0; c < nu_; ++c) smoother_.apply(next_.data() + c, nominal_.data() + c, nu_);
       for (int t = 0; t < options_.horizon; ++t)
@@ -230,7 +282,6 @@ class Controller {
     } else {
       std::copy(next_.begin(), next_.end(), nominal_.begin());
     }
-    return true;
   }
 
   void shift_nominal() {

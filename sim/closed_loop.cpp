@@ -17,6 +17,9 @@
 #include "dynamics/single_track.hpp"
 #include "dynamics/vehicle_params.hpp"
 #include "mppi/controller.hpp"
+#if defined(MPPI_HAVE_VULKAN)
+#include "kernels/make_controller.hpp"
+#endif
 #include "mppi/error.hpp"
 #include "sim/crash_detector.hpp"
 #include "sim/data_dir.hpp"
@@ -43,6 +46,28 @@ struct ControllerSetup {
   std::function<void(const float* plant_x, int plant_states, float* model_x)> observe;
 };
 
+// The controller on the backend the config asks for (Vulkan needs the kernels/ part).
+template <class D>
+std::unique_ptr<Controller> build_controller(const ClosedLoopConfig& config, const D& model,
+                                             const AutoRallyCost& cost) {
+  BackendReport report;
+#if defined(MPPI_HAVE_VULKAN)
+  auto controller = std::make_unique<Controller>(
+      mppi::make_controller(model, cost, config.controller, config.backend, &report));
+#else
+  auto controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
+  report.backend = "cpu";
+  report.reason = config.backend == BackendChoice::kCpu
+                      ? "asked for the CPU backend"
+                      : "built without the Vulkan backend (kernels/); using the CPU backend";
+#endif
+  if (config.progress)
+    std::fprintf(stderr, "backend: %s%s%s (%s)\n", report.backend.c_str(),
+                 report.device.empty() ? "" : " on ", report.device.c_str(), report.reason.c_str());
+  if (config.backend_report) *config.backend_report = report;
+  return controller;
+}
+
 ControllerSetup make_controller(const ClosedLoopConfig& config, const AutoRallyCost& cost) {
   ControllerSetup setup;
   auto copy_common = [](const float* px, int, float* mx) {
@@ -51,12 +76,12 @@ ControllerSetup make_controller(const ClosedLoopConfig& config, const AutoRallyC
   if (config.model == "autorally-nn") {
     auto model = AutoRallyNetwork::load(config.network_npz.empty() ? data_file(kDefaultNetwork)
                                                                    : config.network_npz);
-    setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
+    setup.controller = build_controller(config, model, cost);
     setup.model_states = AutoRallyNetwork::kNx;
     setup.observe = copy_common;
   } else if (config.model == "single-track") {
     const SingleTrack model(single_track_params(config.model_params_yaml));
-    setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
+    setup.controller = build_controller(config, model, cost);
     setup.model_states = SingleTrack::kNx;
     const float radius = static_cast<float>(model.params().wheel_radius_m);
     setup.observe = [radius](const float* px, int plant_states, float* mx) {
@@ -72,7 +97,7 @@ ControllerSetup make_controller(const ClosedLoopConfig& config, const AutoRallyC
                                               ? KinematicBicycleParams{}
                                               : load_kinematic_bicycle_params(config.model_params_yaml);
     const KinematicBicycle model(params);
-    setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
+    setup.controller = build_controller(config, model, cost);
     setup.model_states = KinematicBicycle::kNx;
     // The kinematic bicycle's reference point is the rear axle, l_r behind the CG.
     const float l_r = static_cast<float>(SingleTrackParams{}.cg_to_rear_axle_m);

@@ -7,6 +7,7 @@
 #include <functional>
 #include <string>
 
+#include "mppi/backend_choice.hpp"
 #include "mppi/controller_options.hpp"
 #include "sim/plant.hpp"
 #include "sim/summary.hpp"
@@ -23,6 +24,8 @@ struct ClosedLoopConfig {
   int laps = 5;                           // stop after this many laps
   double max_time_s = 0.0;                // stop after this much simulated time; 0 = from laps
   ControllerOptions controller;           // K, T, seed, threads, noise, lambda, ...
+  BackendChoice backend = BackendChoice::kCpu;  // rollout backend: cpu | vulkan | auto (kernels/make_controller.hpp)
+  BackendReport* backend_report = nullptr;  // if set, receives the backend that ran and why
   std::string cost_params_yaml;           // AutoRally cost weights; empty = data/config default
   std::string plant_params_yaml;          // single-track parameters; empty = data/config default
   std::string model_params_yaml;          // controller-model parameters (physics models)

@@ -1,0 +1,85 @@
+// The single-track model with Pacejka tyres (dynamics/single_track.hpp, dynamics/pacejka.hpp),
+// float, the same fast math. Parameters from P_MODEL, in SingleTrackCoeffs<float> order.
+#define NX 9
+#define K_INV_MASS PARAM(P_MODEL + 0)
+#define K_INV_IZ PARAM(P_MODEL + 1)
+#define K_LF PARAM(P_MODEL + 2)
+#define K_LR PARAM(P_MODEL + 3)
+#define K_H PARAM(P_MODEL + 4)
+#define K_RADIUS PARAM(P_MODEL + 5)
+#define K_INV_IF PARAM(P_MODEL + 6)
+#define K_INV_IR PARAM(P_MODEL + 7)
+#define K_WEIGHT PARAM(P_MODEL + 8)
+#define K_MAX_STEER PARAM(P_MODEL + 9)
+#define K_STALL PARAM(P_MODEL + 10)
+#define K_INV_NO_LOAD PARAM(P_MODEL + 11)
+#define K_ROLLING PARAM(P_MODEL + 12)
+#define K_INV_ROLLING_SPEED PARAM(P_MODEL + 13)
+#define K_DRAG PARAM(P_MODEL + 14)
+#define K_SLIP_FLOOR PARAM(P_MODEL + 15)
+#define K_INV_SLIP_BLEND PARAM(P_MODEL + 16)
+#define K_B PARAM(P_MODEL + 17)
+#define K_C PARAM(P_MODEL + 18)
+#define K_D PARAM(P_MODEL + 19)
+#define K_E PARAM(P_MODEL + 20)
+#define K_SH PARAM(P_MODEL + 21)
+#define K_SV PARAM(P_MODEL + 22)
+
+float maxf(float a, float b) { return (a < b) ? b : a; }  // std::max
+float minf(float a, float b) { return (b < a) ? b : a; }  // std::min
+
+float magic_formula_mu(float total_slip) {
+  precise float se = total_slip - K_SH;
+  precise float bse = K_B * se;
+  precise float s, c;
+  fast_sincos(K_C * fast_atan(bse - K_E * (bse - fast_atan(se))), s, c);
+  return K_D * s + K_SV;
+}
+
+// (mu_x, mu_y) of one tyre from its tyre-frame velocity and rim speed (tyre_friction()).
+vec2 tyre_mu(float v_x, float v_y, float rim_speed) {
+  precise float inv_den = 1.0 / maxf(abs(rim_speed), K_SLIP_FLOOR);
+  precise float slip_x = (v_x - rim_speed) * inv_den;
+  precise float slip_y = v_y * inv_den;
+  precise float slip = fast_sqrt(slip_x * slip_x + slip_y * slip_y);
+  precise float mu = magic_formula_mu(slip);
+  precise float scale = -mu * fast_tanh(slip * K_INV_SLIP_BLEND) / maxf(slip, 1e-12);
+  return vec2(slip_x * scale, slip_y * scale);
+}
+
+void model_step(inout float x[NX], float steer, float throttle, float dt) {
+  precise float vx = x[3], vy = x[4], r = x[5], omega_f = x[7], omega_r = x[8];
+  precise float delta = minf(maxf(steer, -1.0), 1.0) * K_MAX_STEER;
+  precise float sd, cd;
+  fast_sincos(delta, sd, cd);
+  precise float vy_front = vy + r * K_LF;
+  precise float front_vx = vx * cd + vy_front * sd;
+  precise float front_vy = -vx * sd + vy_front * cd;
+  vec2 fmu = tyre_mu(front_vx, front_vy, omega_f * K_RADIUS);
+  vec2 rmu = tyre_mu(vx, vy - r * K_LR, omega_r * K_RADIUS);
+  precise float den = K_LF + K_LR + K_H * (fmu.x * cd - fmu.y * sd - rmu.x);
+  precise float fz_front = K_WEIGHT * (K_LR - K_H * rmu.x) / maxf(den, 1e-3);
+  precise float front_fz = minf(maxf(fz_front, 0.0), K_WEIGHT);
+  precise float rear_fz = K_WEIGHT - front_fz;
+  precise float ffx = fmu.x * front_fz, ffy = fmu.y * front_fz;
+  precise float rfx = rmu.x * rear_fz, rfy = rmu.y * rear_fz;
+  precise float drive = K_STALL * (throttle - omega_r * K_RADIUS * K_INV_NO_LOAD);
+  precise float resist = -K_ROLLING * fast_tanh(vx * K_INV_ROLLING_SPEED) - K_DRAG * vx * abs(vx);
+  precise float body_fx = ffx * cd - ffy * sd + rfx;
+  precise float body_fy = ffx * sd + ffy * cd + rfy;
+  precise float dvx = (body_fx + resist) * K_INV_MASS + vy * r;
+  precise float dvy = body_fy * K_INV_MASS - vx * r;
+  precise float dr = ((ffy * cd + ffx * sd) * K_LF - rfy * K_LR) * K_INV_IZ;
+  precise float dwf = -ffx * K_RADIUS * K_INV_IF;
+  precise float dwr = (drive - rfx * K_RADIUS) * K_INV_IR;
+  precise float sy, cy;
+  fast_sincos(x[2], sy, cy);
+  x[0] += (cy * vx - sy * vy) * dt;
+  x[1] += (sy * vx + cy * vy) * dt;
+  x[2] += r * dt;
+  x[3] = vx + dvx * dt;
+  x[4] = vy + dvy * dt;
+  x[5] = r + dr * dt;
+  x[7] += dwf * dt;
+  x[8] += dwr * dt;
+}

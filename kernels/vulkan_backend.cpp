@@ -1,0 +1,529 @@
+// The Vulkan backend: device set-up, buffers, pipelines and the two recorded command buffers.
+#include "kernels/vulkan_backend.hpp"
+
+#include <stdint.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "kernels/vulkan_api.hpp"
+#include "mppi/cpu_backend.hpp"
+#include "mppi/error.hpp"
+
+// SPIR-V made at build time by glslangValidator (kernels/CMakeLists.txt), checked by spirv-val.
+#include "rollout_kinematic.spv.h"
+#include "rollout_network.spv.h"
+#include "rollout_single_track.spv.h"
+#include "reduce.spv.h"
+#include "weighted_sum.spv.h"
+
+namespace mppi::vulkan {
+
+namespace {
+constexpr int kRolloutGroup = 64;      // invocations per workgroup of the rollout shader
+constexpr int kParamFloats = 4096;     // the parameter uniform buffer: vec4 params[1024]
+constexpr int kCostFloats = 16;        // its first 16 floats are the cost (interface.glsl)
+constexpr int kNu = 2;                 // every GPU twin has (steer, throttle)
+constexpr int kMaxStates = 16;
+
+// std140 mirror of StepBlock in shaders/interface.glsl.
+struct StepUbo {
+  std::uint32_t sizes[4];  // K, T, padded, iteration
+  std::uint32_t seed[4];   // seed low, seed high
+  float scalars[4];        // dt, gamma, 1 / lambda
+  float noise_std[4];
+  float control_min[4];
+  float control_max[4];
+  float x0[kMaxStates];
+};
+
+void check(VkResult r, const char* what) {
+  if (r != VK_SUCCESS)
+    throw Error(std::string("Vulkan backend: ") + what + " failed: " + detail::result_name(r));
+}
+
+// The cost's floats at the start of the parameter block (the P_* offsets of interface.glsl).
+void pack_cost(const AutoRallyCost& cost, float* p) {
+  const AutoRallyCostParams& c = cost.params();
+  const CostMap::View v = cost.map().view();
+  p[0] = c.track_weight;
+  p[1] = c.speed_weight;
+  p[2] = c.crash_weight;
+  p[3] = c.slip_weight;
+  p[4] = c.target_speed_mps;
+  p[5] = c.boundary_threshold;
+  p[6] = c.max_roll_rad;
+  p[7] = c.max_yaw_rate_radps;
+  p[8] = c.slip_min_speed_mps;
+  p[9] = v.x_min_m;
+  p[10] = v.y_min_m;
+  p[11] = v.pixels_per_meter;
+  p[12] = v.max_col;
+  p[13] = v.max_row;
+  p[14] = static_cast<float>(v.width);
+}
+}  // namespace
+
+// ---- the GPU twins ----------------------------------------------------------------------------
+
+std::optional<TwinModel> twin_of(const KinematicBicycle& m, std::string*) {
+  const KinematicBicycleParams& p = m.params();
+  TwinModel t;
+  t.kind = TwinModel::Kind::kKinematic;
+  t.num_states = KinematicBicycle::kNx;
+  // as KinematicBicycle's constructor computes them
+  t.params = {static_cast<float>(1 / p.wheelbase_m), static_cast<float>(p.max_steer_rad),
+              static_cast<float>(p.max_accel_mps2), static_cast<float>(p.speed_damping_per_s)};
+  return t;
+}
+
+std::optional<TwinModel> twin_of(const AutoRallyNetwork& m, std::string* why) {
+  const std::vector<DenseLayer>& layers = m.network().layers();
+  auto fail = [&](const std::string& msg) -> std::optional<TwinModel> {
+    if (why) *why = "no GPU twin for this network: " + msg;
+    return std::nullopt;
+  };
+  if (layers.size() != 3) return fail("the shader runs 3 layers, the network has " + std::to_string(layers.size()));
+  if (layers[0].activation != Activation::kTanh || layers[1].activation != Activation::kTanh ||
+      layers[2].activation != Activation::kLinear)
+    return fail("the shader runs tanh, tanh, linear layers");
+  const int h1 = layers[0].n_out, h2 = layers[1].n_out;
+  if (h1 > 128 || h2 > 128) return fail("hidden layers wider than 128");
+  TwinModel t;
+  t.kind = TwinModel::Kind::kNetwork;
+  t.num_states = AutoRallyNetwork::kNx;
+  t.hidden1 = h1;
+  t.hidden2 = h2;
+  // Each layer: W with every row padded to a multiple of 4 floats, then b padded to a multiple
+  // of 4 (the layout shaders/model_network.glsl reads 4 weights at a time).
+  auto pad4 = [](int n) { return (n + 3) / 4 * 4; };
+  for (const DenseLayer& l : layers) {
+    for (int o = 0; o < l.n_out; ++o) {
+      const auto row = l.weights.begin() + static_cast<std::ptrdiff_t>(o) * l.n_in;
+      t.params.insert(t.params.end(), row, row + l.n_in);
+      t.params.resize(t.params.size() + static_cast<std::size_t>(pad4(l.n_in) - l.n_in), 0.f);
+    }
+    t.params.insert(t.params.end(), l.bias.begin(), l.bias.end());
+    t.params.resize(t.params.size() + static_cast<std::size_t>(pad4(l.n_out) - l.n_out), 0.f);
+  }
+  if (static_cast<int>(t.params.size()) + kCostFloats > kParamFloats)
+    return fail("its " + std::to_string(t.params.size()) + " weights do not fit the 16 KiB uniform buffer");
+  return t;
+}
+
+std::optional<TwinModel> twin_of(const SingleTrack& m, std::string*) {
+  const auto k = SingleTrackCoeffs<float>::from(m.params());
+  TwinModel t;
+  t.kind = TwinModel::Kind::kSingleTrack;
+  t.num_states = SingleTrack::kNx;
+  t.params = {k.inv_mass, k.inv_yaw_inertia, k.lf, k.lr, k.h, k.radius, k.inv_front_inertia,
+              k.inv_rear_inertia, k.weight, k.max_steer, k.stall_torque, k.inv_no_load_speed,
+              k.rolling_force, k.inv_rolling_speed, k.drag, k.slip_floor, k.inv_slip_blend,
+              k.tyre.B, k.tyre.C, k.tyre.D, k.tyre.E, k.tyre.Sh, k.tyre.Sv};
+  return t;
+}
+
+// ---- the backend ------------------------------------------------------------------------------
+
+struct VulkanBackend::Impl {
+  struct Buffer {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    void* mapped = nullptr;
+    VkDeviceSize bytes = 0;
+    float* f() const { return static_cast<float*>(mapped); }
+  };
+  enum Binding { kStep, kNominal, kControls, kCosts, kMap, kParams, kCrash, kWeights, kStats, kNext, kBindings };
+
+  detail::Api api;
+  VkInstance instance = VK_NULL_HANDLE;
+  VkPhysicalDevice physical = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;
+  VkPhysicalDeviceMemoryProperties memory_props{};
+  Buffer buffers[kBindings];
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
+  VkPipeline rollout_generate = VK_NULL_HANDLE, rollout_given = VK_NULL_HANDLE;
+  VkPipeline reduce = VK_NULL_HANDLE, weighted_sum = VK_NULL_HANDLE;
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+  VkCommandPool command_pool = VK_NULL_HANDLE;
+  VkCommandBuffer cmd_iterate = VK_NULL_HANDLE, cmd_rollout = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  RolloutShape shape;
+  int num_states = 0;
+  float dt_s = 0.f;
+
+  ~Impl() { destroy(); }
+
+  void destroy() {
+    if (!device) {
+      if (instance) api.vkDestroyInstance(instance, nullptr);
+      instance = VK_NULL_HANDLE;
+      return;
+    }
+    api.vkDeviceWaitIdle(device);
+    if (fence) api.vkDestroyFence(device, fence, nullptr);
+    if (command_pool) api.vkDestroyCommandPool(device, command_pool, nullptr);
+    if (pool) api.vkDestroyDescriptorPool(device, pool, nullptr);
+    for (VkPipeline p : {rollout_generate, rollout_given, reduce, weighted_sum})
+      if (p) api.vkDestroyPipeline(device, p, nullptr);
+    if (pipeline_layout) api.vkDestroyPipelineLayout(device, pipeline_layout, nullptr);
+    if (set_layout) api.vkDestroyDescriptorSetLayout(device, set_layout, nullptr);
+    for (Buffer& b : buffers) {
+      if (b.buffer) api.vkDestroyBuffer(device, b.buffer, nullptr);
+      if (b.memory) api.vkFreeMemory(device, b.memory, nullptr);  // unmaps too
+    }
+    api.vkDestroyDevice(device, nullptr);
+    api.vkDestroyInstance(instance, nullptr);
+    device = VK_NULL_HANDLE;
+    instance = VK_NULL_HANDLE;
+  }
+
+  void create_device(int device_index, std::string* name, bool* is_cpu) {
+    std::string why;
+    const detail::Api* global = detail::global_api(&why);
+    if (!global) throw Error("Vulkan backend: " + why);
+    api = *global;
+    VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+    app.pApplicationName = "mppi";
+    app.apiVersion = VK_API_VERSION_1_1;
+    VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    info.pApplicationInfo = &app;
+    check(api.vkCreateInstance(&info, nullptr, &instance), "vkCreateInstance");
+    if (!detail::load_instance_functions(api, instance, &why)) throw Error("Vulkan backend: " + why);
+    std::uint32_t count = 0;
+    api.vkEnumeratePhysicalDevices(instance, &count, nullptr);
+    std::vector<VkPhysicalDevice> devices(count);
+    if (count) api.vkEnumeratePhysicalDevices(instance, &count, devices.data());
+    if (device_index < 0 || device_index >= static_cast<int>(count))
+      throw Error("Vulkan backend: no device " + std::to_string(device_index));
+    physical = devices[device_index];
+    VkPhysicalDeviceProperties props;
+    api.vkGetPhysicalDeviceProperties(physical, &props);
+    *name = props.deviceName;
+    *is_cpu = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    if (props.limits.maxUniformBufferRange < kParamFloats * sizeof(float))
+      throw Error("Vulkan backend: the device's uniform buffers are smaller than 16 KiB");
+    api.vkGetPhysicalDeviceMemoryProperties(physical, &memory_props);
+
+    std::uint32_t families = 0;
+    api.vkGetPhysicalDeviceQueueFamilyProperties(physical, &families, nullptr);
+    std::vector<VkQueueFamilyProperties> family_props(families);
+    api.vkGetPhysicalDeviceQueueFamilyProperties(physical, &families, family_props.data());
+    std::uint32_t family = families;
+    for (std::uint32_t i = 0; i < families && family == families; ++i)
+      if (family_props[i].queueFlags & VK_QUEUE_COMPUTE_BIT) family = i;
+    if (family == families) throw Error("Vulkan backend: device " + *name + " has no compute queue");
+    const float priority = 1.f;
+    VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+    queue_info.queueFamilyIndex = family;
+    queue_info.queueCount = 1;
+    queue_info.pQueuePriorities = &priority;
+    VkDeviceCreateInfo device_info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+    device_info.queueCreateInfoCount = 1;
+    device_info.pQueueCreateInfos = &queue_info;
+    check(api.vkCreateDevice(physical, &device_info, nullptr, &device), "vkCreateDevice");
+    if (!detail::load_device_functions(api, device, &why)) throw Error("Vulkan backend: " + why);
+    api.vkGetDeviceQueue(device, family, 0, &queue);
+
+    VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    pool_info.queueFamilyIndex = family;
+    check(api.vkCreateCommandPool(device, &pool_info, nullptr, &command_pool), "vkCreateCommandPool");
+    VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    check(api.vkCreateFence(device, &fence_info, nullptr, &fence), "vkCreateFence");
+  }
+
+  // Host-visible, coherent memory (device-local as well where the device offers it: then the
+  // GPU reads and writes it at full speed and the host maps it directly).
+  void create_buffer(Buffer& b, VkDeviceSize bytes, VkBufferUsageFlags usage) {
+    b.bytes = std::max<VkDeviceSize>(bytes, 16);
+    VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    info.size = b.bytes;
+    info.usage = usage;
+    info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    check(api.vkCreateBuffer(device, &info, nullptr, &b.buffer), "vkCreateBuffer");
+    VkMemoryRequirements req;
+    api.vkGetBufferMemoryRequirements(device, b.buffer, &req);
+    const VkMemoryPropertyFlags need = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    std::uint32_t type = memory_props.memoryTypeCount;
+    for (VkMemoryPropertyFlags want : {need | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, need}) {
+      for (std::uint32_t i = 0; i < memory_props.memoryTypeCount && type == memory_props.memoryTypeCount; ++i)
+        if ((req.memoryTypeBits & (1u << i)) &&
+            (memory_props.memoryTypes[i].propertyFlags & want) == want)
+          type = i;
+      if (type != memory_props.memoryTypeCount) break;
+    }
+    if (type == memory_props.memoryTypeCount) throw Error("Vulkan backend: no host-visible coherent memory");
+    VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    alloc.allocationSize = req.size;
+    alloc.memoryTypeIndex = type;
+    VkResult r = api.vkAllocateMemory(device, &alloc, nullptr, &b.memory);
+    if (r != VK_SUCCESS && (memory_props.memoryTypes[type].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT)) {
+      // the device-local host-visible heap can be small (256 MiB BAR): fall back to system memory
+      for (std::uint32_t i = 0; i < memory_props.memoryTypeCount; ++i)
+        if ((req.memoryTypeBits & (1u << i)) && (memory_props.memoryTypes[i].propertyFlags & need) == need &&
+            !(memory_props.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT)) {
+          alloc.memoryTypeIndex = i;
+          r = api.vkAllocateMemory(device, &alloc, nullptr, &b.memory);
+          break;
+        }
+    }
+    check(r, "vkAllocateMemory");
+    check(api.vkBindBufferMemory(device, b.buffer, b.memory, 0), "vkBindBufferMemory");
+    check(api.vkMapMemory(device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
+    std::memset(b.mapped, 0, b.bytes);
+  }
+
+  VkPipeline make_pipeline(const std::uint32_t* code, std::size_t bytes, const VkSpecializationInfo* spec) {
+    VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    module_info.codeSize = bytes;
+    module_info.pCode = code;
+    VkShaderModule module = VK_NULL_HANDLE;
+    check(api.vkCreateShaderModule(device, &module_info, nullptr, &module), "vkCreateShaderModule");
+    VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    info.stage.module = module;
+    info.stage.pName = "main";
+    info.stage.pSpecializationInfo = spec;
+    info.layout = pipeline_layout;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    const VkResult r = api.vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline);
+    api.vkDestroyShaderModule(device, module, nullptr);
+    check(r, "vkCreateComputePipelines");
+    return pipeline;
+  }
+
+  void create_pipelines(const TwinModel& model) {
+    VkDescriptorSetLayoutBinding bindings[kBindings];
+    for (int i = 0; i < kBindings; ++i) {
+      bindings[i] = {};
+      bindings[i].binding = static_cast<std::uint32_t>(i);
+      bindings[i].descriptorType = (i == kStep || i == kParams) ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
+                                                                : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      bindings[i].descriptorCount = 1;
+      bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    }
+    VkDescriptorSetLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    layout_info.bindingCount = kBindings;
+    layout_info.pBindings = bindings;
+    check(api.vkCreateDescriptorSetLayout(device, &layout_info, nullptr, &set_layout), "vkCreateDescriptorSetLayout");
+    VkPipelineLayoutCreateInfo pl_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    pl_info.setLayoutCount = 1;
+    pl_info.pSetLayouts = &set_layout;
+    check(api.vkCreatePipelineLayout(device, &pl_info, nullptr, &pipeline_layout), "vkCreatePipelineLayout");
+
+    const std::uint32_t* code = nullptr;
+    std::size_t bytes = 0;
+    switch (model.kind) {
+      case TwinModel::Kind::kKinematic: code = rollout_kinematic_spv; bytes = sizeof rollout_kinematic_spv; break;
+      case TwinModel::Kind::kNetwork: code = rollout_network_spv; bytes = sizeof rollout_network_spv; break;
+      case TwinModel::Kind::kSingleTrack: code = rollout_single_track_spv; bytes = sizeof rollout_single_track_spv; break;
+    }
+    struct Spec {
+      std::uint32_t group;
+      VkBool32 generate;
+      std::int32_t hidden1, hidden2;
+    };
+    const VkSpecializationMapEntry entries[] = {{0, offsetof(Spec, group), 4},
+                                                {1, offsetof(Spec, generate), 4},
+                                                {2, offsetof(Spec, hidden1), 4},
+                                                {3, offsetof(Spec, hidden2), 4}};
+    Spec values{kRolloutGroup, VK_TRUE, std::max(model.hidden1, 1), std::max(model.hidden2, 1)};
+    VkSpecializationInfo spec{4, entries, sizeof(Spec), &values};
+    rollout_generate = make_pipeline(code, bytes, &spec);
+    values.generate = VK_FALSE;
+    rollout_given = make_pipeline(code, bytes, &spec);
+    reduce = make_pipeline(reduce_spv, sizeof reduce_spv, nullptr);
+    weighted_sum = make_pipeline(weighted_sum_spv, sizeof weighted_sum_spv, nullptr);
+
+    VkDescriptorPoolSize sizes[] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2},
+                                    {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings - 2}};
+    VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    pool_info.maxSets = 1;
+    pool_info.poolSizeCount = 2;
+    pool_info.pPoolSizes = sizes;
+    check(api.vkCreateDescriptorPool(device, &pool_info, nullptr, &pool), "vkCreateDescriptorPool");
+    VkDescriptorSetAllocateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    set_info.descriptorPool = pool;
+    set_info.descriptorSetCount = 1;
+    set_info.pSetLayouts = &set_layout;
+    check(api.vkAllocateDescriptorSets(device, &set_info, &set), "vkAllocateDescriptorSets");
+    VkDescriptorBufferInfo infos[kBindings];
+    VkWriteDescriptorSet writes[kBindings];
+    for (int i = 0; i < kBindings; ++i) {
+      infos[i] = {buffers[i].buffer, 0, VK_WHOLE_SIZE};
+      writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+      writes[i].dstSet = set;
+      writes[i].dstBinding = static_cast<std::uint32_t>(i);
+      writes[i].descriptorCount = 1;
+      writes[i].descriptorType = bindings[i].descriptorType;
+      writes[i].pBufferInfo = &infos[i];
+    }
+    api.vkUpdateDescriptorSets(device, kBindings, writes, 0, nullptr);
+  }
+
+  void barrier(VkCommandBuffer cmd, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) {
+    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    b.dstAccessMask = dst_access;
+    api.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, dst_stage, 0, 1, &b, 0, nullptr, 0, nullptr);
+  }
+
+  void record() {
+    VkCommandBufferAllocateInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    info.commandPool = command_pool;
+    info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    info.commandBufferCount = 2;
+    VkCommandBuffer cmds[2];
+    check(api.vkAllocateCommandBuffers(device, &info, cmds), "vkAllocateCommandBuffers");
+    cmd_iterate = cmds[0];
+    cmd_rollout = cmds[1];
+    const auto groups = static_cast<std::uint32_t>((shape.num_samples + kRolloutGroup - 1) / kRolloutGroup);
+    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    // iterate: sample + roll out, weights, weighted sum
+    check(api.vkBeginCommandBuffer(cmd_iterate, &begin), "vkBeginCommandBuffer");
+    api.vkCmdBindDescriptorSets(cmd_iterate, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout, 0, 1, &set, 0, nullptr);
+    api.vkCmdBindPipeline(cmd_iterate, VK_PIPELINE_BIND_POINT_COMPUTE, rollout_generate);
+    api.vkCmdDispatch(cmd_iterate, groups, 1, 1);
+    barrier(cmd_iterate, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    api.vkCmdBindPipeline(cmd_iterate, VK_PIPELINE_BIND_POINT_COMPUTE, reduce);
+    api.vkCmdDispatch(cmd_iterate, 1, 1, 1);
+    barrier(cmd_iterate, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    api.vkCmdBindPipeline(cmd_iterate, VK_PIPELINE_BIND_POINT_COMPUTE, weighted_sum);
+    api.vkCmdDispatch(cmd_iterate, static_cast<std::uint32_t>(shape.horizon * kNu), 1, 1);
+    barrier(cmd_iterate, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+    check(api.vkEndCommandBuffer(cmd_iterate), "vkEndCommandBuffer");
+    // rollout: the given controls only
+    check(api.vkBeginCommandBuffer(cmd_rollout, &begin), "vkBeginCommandBuffer");
+    api.vkCmdBindDescriptorSets(cmd_rollout, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout, 0, 1, &set, 0, nullptr);
+    api.vkCmdBindPipeline(cmd_rollout, VK_PIPELINE_BIND_POINT_COMPUTE, rollout_given);
+    api.vkCmdDispatch(cmd_rollout, groups, 1, 1);
+    barrier(cmd_rollout, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+    check(api.vkEndCommandBuffer(cmd_rollout), "vkEndCommandBuffer");
+  }
+
+  void submit(VkCommandBuffer cmd) {
+    VkSubmitInfo info{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    info.commandBufferCount = 1;
+    info.pCommandBuffers = &cmd;
+    check(api.vkQueueSubmit(queue, 1, &info, fence), "vkQueueSubmit");
+    check(api.vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+    check(api.vkResetFences(device, 1, &fence), "vkResetFences");
+  }
+
+  StepUbo& step_ubo() const { return *static_cast<StepUbo*>(buffers[kStep].mapped); }
+
+  void write_step(std::span<const float> x0, std::uint32_t iteration) {
+    StepUbo& s = step_ubo();
+    s.sizes[0] = static_cast<std::uint32_t>(shape.num_samples);
+    s.sizes[1] = static_cast<std::uint32_t>(shape.horizon);
+    s.sizes[2] = static_cast<std::uint32_t>(shape.padded_samples);
+    s.sizes[3] = iteration;
+    s.scalars[0] = dt_s;
+    std::copy_n(x0.begin(), std::min<std::size_t>(x0.size(), kMaxStates), s.x0);
+  }
+};
+
+VulkanBackend::VulkanBackend(const TwinModel& model, const AutoRallyCost& cost, int num_samples,
+                             int horizon, float dt_s, int device_index)
+    : impl_(std::make_unique<Impl>()) {
+  if (num_samples < 1 || horizon < 1) throw Error("VulkanBackend: need num_samples, horizon >= 1");
+  if (model.num_states > kMaxStates) throw Error("VulkanBackend: model has too many states");
+  Impl& m = *impl_;
+  shape_ = {num_samples, padded_sample_count(num_samples), horizon, model.num_states, kNu};
+  m.shape = shape_;
+  m.num_states = model.num_states;
+  m.dt_s = dt_s;
+  m.create_device(device_index, &device_name_, &device_is_cpu_);
+
+  const auto f = sizeof(float);
+  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  const std::size_t plan = static_cast<std::size_t>(horizon) * kNu;
+  const std::size_t padded = static_cast<std::size_t>(shape_.padded_samples);
+  const CostMap& map = cost.map();
+  m.create_buffer(m.buffers[Impl::kStep], sizeof(StepUbo), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  m.create_buffer(m.buffers[Impl::kNominal], plan * f, storage);
+  m.create_buffer(m.buffers[Impl::kControls], plan * padded * f, storage);
+  m.create_buffer(m.buffers[Impl::kCosts], padded * f, storage);
+  m.create_buffer(m.buffers[Impl::kMap], map.values().size() * f, storage);
+  m.create_buffer(m.buffers[Impl::kParams], kParamFloats * f, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  m.create_buffer(m.buffers[Impl::kCrash], static_cast<std::size_t>(horizon) * f, storage);
+  m.create_buffer(m.buffers[Impl::kWeights], padded * f, storage);
+  m.create_buffer(m.buffers[Impl::kStats], 8 * f, storage);
+  m.create_buffer(m.buffers[Impl::kNext], plan * f, storage);
+
+  // Constant data: cost + model parameters, the cost map, the crash cost per step (computed
+  // here with the CPU's own std::pow so both sides use the same numbers).
+  float* params = m.buffers[Impl::kParams].f();
+  pack_cost(cost, params);
+  std::copy(model.params.begin(), model.params.end(), params + kCostFloats);
+  std::copy(map.values().begin(), map.values().end(), m.buffers[Impl::kMap].f());
+  for (int t = 0; t < horizon; ++t) m.buffers[Impl::kCrash].f()[t] = cost.crash_cost_at(t);
+
+  m.create_pipelines(model);
+  m.record();
+
+  // Warm-up: run both command buffers once (lavapipe compiles a shader at its first dispatch).
+  StepUbo& s = m.step_ubo();
+  const std::vector<float> x0(static_cast<std::size_t>(model.num_states), 0.f);
+  m.write_step(x0, 0);
+  for (int c = 0; c < kNu; ++c) {
+    s.noise_std[c] = 0.1f;
+    s.control_min[c] = -1.f;
+    s.control_max[c] = 1.f;
+  }
+  s.scalars[2] = 1.f;
+  m.submit(m.cmd_iterate);
+  m.submit(m.cmd_rollout);
+}
+
+VulkanBackend::~VulkanBackend() = default;
+
+void VulkanBackend::rollout(std::span<const float> x0, std::span<const float> controls,
+                            std::span<float> costs) {
+  Impl& m = *impl_;
+  m.write_step(x0, 0);
+  const std::size_t n = std::min<std::size_t>(controls.size(), m.buffers[Impl::kControls].bytes / sizeof(float));
+  std::copy_n(controls.begin(), n, m.buffers[Impl::kControls].f());
+  m.submit(m.cmd_rollout);
+  std::copy_n(m.buffers[Impl::kCosts].f(), std::min<std::size_t>(costs.size(), shape_.num_samples), costs.begin());
+}
+
+void VulkanBackend::iterate(const IterationInput& in, IterationOutput& out) {
+  Impl& m = *impl_;
+  m.write_step(in.x0, in.iteration);
+  StepUbo& s = m.step_ubo();
+  s.seed[0] = static_cast<std::uint32_t>(in.seed);
+  s.seed[1] = static_cast<std::uint32_t>(in.seed >> 32);
+  s.scalars[1] = in.gamma;
+  s.scalars[2] = 1.f / in.lambda;
+  for (int c = 0; c < kNu; ++c) {
+    s.noise_std[c] = in.noise_std[c];
+    s.control_min[c] = in.control_min[c];
+    s.control_max[c] = in.control_max[c];
+  }
+  std::copy(in.nominal.begin(), in.nominal.end(), m.buffers[Impl::kNominal].f());
+  m.submit(m.cmd_iterate);
+  const float* stats = m.buffers[Impl::kStats].f();
+  out.min_cost = stats[0];
+  out.sum_sq_weights = stats[2];
+  out.valid_samples = static_cast<int>(stats[3]);
+  out.mean_cost = out.valid_samples > 0 ? stats[4] / stats[3] : 0.f;
+  const auto k = static_cast<std::size_t>(shape_.num_samples);
+  std::copy_n(m.buffers[Impl::kNext].f(), std::min(out.next.size(), static_cast<std::size_t>(shape_.horizon) * kNu), out.next.begin());
+  std::copy_n(m.buffers[Impl::kCosts].f(), std::min(out.costs.size(), k), out.costs.begin());
+  std::copy_n(m.buffers[Impl::kWeights].f(), std::min(out.weights.size(), k), out.weights.begin());
+}
+
+std::span<const float> VulkanBackend::sampled_controls() const {
+  const Impl::Buffer& b = impl_->buffers[Impl::kControls];
+  return {b.f(), static_cast<std::size_t>(shape_.horizon) * kNu * shape_.padded_samples};
+}
+
+}  // namespace mppi::vulkan

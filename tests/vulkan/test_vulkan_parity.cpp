@@ -1,0 +1,161 @@
+// Parity of the Vulkan backend with the CPU backend, on whatever Vulkan device exists (in CI:
+// lavapipe). The oracle is the CPU backend (itself tested against closed forms and double
+// references): for every model with a GPU twin, under the AutoRally cost on the Gazebo map,
+// the per-sample total costs must agree within 1e-3 relative and the first control within
+// 1e-4, for K not a multiple of the workgroup size (64) and T = 100 and T = 500 (lavapipe
+// silently stops a shader's loops after 65,535 iterations: a truncated rollout would miss
+// hundreds of steps of cost and fail here).
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "costs/autorally_cost.hpp"
+#include "costs/cost_map.hpp"
+#include "dynamics/autorally_nn.hpp"
+#include "dynamics/kinematic_bicycle.hpp"
+#include "dynamics/single_track.hpp"
+#include "kernels/make_controller.hpp"
+#include "mppi/controller.hpp"
+#include "vulkan/vulkan_test_util.hpp"
+
+namespace {
+
+std::string data(const std::string& rel) { return std::string(MPPI_TEST_DATA_DIR) + "/" + rel; }
+
+const mppi::AutoRallyCost& gazebo_cost() {
+  static const mppi::AutoRallyCost cost(std::make_shared<const mppi::CostMap>(
+      mppi::CostMap::load_npz(data("autorally/maps/gazebo/gazebo_costmap.npz"))));
+  return cost;
+}
+
+mppi::ControllerOptions parity_options(int k, int t) {
+  mppi::ControllerOptions o;
+  o.num_samples = k;
+  o.horizon = t;
+  o.gamma = 0.1f;  // exercise the control cost too
+  o.seed = 12345;
+  return o;
+}
+
+// On the Gazebo centreline heading along the straight at 5 m/s, slightly yawing.
+std::vector<float> start_state(int nx) {
+  std::vector<float> x(static_cast<std::size_t>(nx), 0.f);
+  x[mppi::state::kX] = -8.5f;
+  x[mppi::state::kY] = -8.9f;
+  x[mppi::state::kYaw] = 2.3561945f;
+  x[mppi::state::kVx] = 5.f;
+  x[mppi::state::kYawRate] = 0.1f;
+  if (nx == mppi::SingleTrack::kNx)
+    x[mppi::SingleTrack::kOmegaFront] = x[mppi::SingleTrack::kOmegaRear] =
+        5.f / static_cast<float>(mppi::SingleTrackParams{}.wheel_radius_m);
+  return x;
+}
+
+struct Worst {
+  double cost_rel = 0, control = 0, sampled = 0;
+};
+
+// Two control steps on the CPU and on Vulkan from the same state: compare the sampled
+// controls (the device's Philox), the per-sample costs and the returned first control.
+template <class D>
+Worst compare(const D& model, int device, int k, int t) {
+  const mppi::ControllerOptions o = parity_options(k, t);
+  mppi::Controller cpu = mppi::make_cpu_controller(model, gazebo_cost(), o);
+  std::string why;
+  const auto twin = mppi::vulkan::twin_of(model, &why);
+  REQUIRE(twin);
+  mppi::Controller gpu(std::make_unique<mppi::vulkan::VulkanBackend>(*twin, gazebo_cost(), k, t,
+                                                                     o.dt_s, device),
+                       o);
+  Worst w;
+  const std::vector<float> x0 = start_state(D::kNx);
+  for (int step = 0; step < 2; ++step) {
+    mppi::StepSummary sc, sg;
+    const auto uc = cpu.step(x0, &sc);
+    const std::vector<float> u_cpu(uc.begin(), uc.end());
+    const auto ug = gpu.step(x0, &sg);
+    REQUIRE(sc.status == mppi::StepStatus::kOk);
+    REQUIRE(sg.status == mppi::StepStatus::kOk);
+    CHECK(sg.valid_samples == sc.valid_samples);
+    const auto vc = cpu.sampled_controls();
+    const auto vg = gpu.sampled_controls();
+    REQUIRE(vg.size() == vc.size());
+    for (int r = 0; r < t * D::kNu; ++r)
+      for (int j = 0; j < k; ++j) {
+        const std::size_t i = static_cast<std::size_t>(r) * cpu.backend().shape().padded_samples + j;
+        w.sampled = std::max(w.sampled, static_cast<double>(std::abs(vc[i] - vg[i])));
+      }
+    const auto cc = cpu.sampled_costs();
+    const auto cg = gpu.sampled_costs();
+    REQUIRE(cg.size() == static_cast<std::size_t>(k));
+    for (int j = 0; j < k; ++j) {
+      const double rel = std::abs(static_cast<double>(cc[j]) - cg[j]) / std::max(1.0, std::abs(static_cast<double>(cc[j])));
+      w.cost_rel = std::max(w.cost_rel, rel);
+    }
+    for (int c = 0; c < D::kNu; ++c)
+      w.control = std::max(w.control, static_cast<double>(std::abs(u_cpu[c] - ug[c])));
+    CHECK(sg.effective_sample_size == Approx(sc.effective_sample_size).epsilon(1e-2));
+  }
+  return w;
+}
+
+template <class D>
+void check_parity(const D& model, const char* name) {
+  const int device = mppi::test::vulkan_test_device();
+  if (device < 0) return;
+  for (const int t : {100, 500}) {
+    const int k = t == 100 ? 1000 : 333;  // neither is a multiple of the workgroup size (64)
+    const Worst w = compare(model, device, k, t);
+    INFO(name << ": K = " << k << ", T = " << t << ": worst cost rel. diff " << w.cost_rel
+              << ", first-control diff " << w.control << ", sampled-control diff " << w.sampled);
+    CHECK(w.sampled <= 1e-5);  // same Philox numbers (last-bit differences from FMA only)
+    CHECK(w.cost_rel <= 1e-3);
+    CHECK(w.control <= 1e-4);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("Vulkan parity: kinematic bicycle, AutoRally cost", "[vulkan][parity]") {
+  check_parity(mppi::KinematicBicycle{}, "kinematic");
+}
+
+TEST_CASE("Vulkan parity: AutoRally network, AutoRally cost", "[vulkan][parity]") {
+  check_parity(mppi::AutoRallyNetwork::load(data("autorally/models/autorally_nnet_09_12_2018.npz")),
+               "network");
+}
+
+TEST_CASE("Vulkan parity: single-track Pacejka model, AutoRally cost", "[vulkan][parity]") {
+  check_parity(mppi::SingleTrack{}, "single-track");
+}
+
+TEST_CASE("Vulkan rollout() of given controls equals the CPU backend's", "[vulkan][parity]") {
+  const int device = mppi::test::vulkan_test_device();
+  if (device < 0) return;
+  const auto net = mppi::AutoRallyNetwork::load(data("autorally/models/autorally_nnet_09_12_2018.npz"));
+  const int k = 200, t = 500;
+  mppi::CpuBackend<mppi::AutoRallyNetwork, mppi::AutoRallyCost> cpu(net, gazebo_cost(), k, t, 0.02f, 0);
+  mppi::vulkan::VulkanBackend gpu(*mppi::vulkan::twin_of(net, nullptr), gazebo_cost(), k, t, 0.02f, device);
+  const int padded = cpu.shape().padded_samples;
+  REQUIRE(gpu.shape().padded_samples == padded);
+  // Smooth, distinct control sequences: a slow steering sine per sample, constant throttle.
+  std::vector<float> v(static_cast<std::size_t>(t) * 2 * padded, 0.f);
+  for (int s = 0; s < t; ++s)
+    for (int j = 0; j < padded; ++j) {
+      v[(static_cast<std::size_t>(s) * 2 + 0) * padded + j] = 0.4f * std::sin(0.01f * s * (1 + j % 7) + j);
+      v[(static_cast<std::size_t>(s) * 2 + 1) * padded + j] = 0.2f + 0.002f * (j % 50);
+    }
+  const std::vector<float> x0 = start_state(7);
+  std::vector<float> cc(padded), cg(padded);
+  cpu.rollout(x0, v, cc);
+  gpu.rollout(x0, v, cg);
+  for (int j = 0; j < k; ++j) {
+    INFO("sample " << j);
+    REQUIRE(std::isfinite(cg[j]));
+    CHECK(cg[j] == Approx(cc[j]).epsilon(1e-3));
+  }
+}
