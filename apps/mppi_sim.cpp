@@ -13,8 +13,10 @@ namespace {
 const char* kUsage = R"(usage: mppi-sim [options]
   --track NAME         gazebo | marietta | ccrf                      (default gazebo)
   --clockwise          drive clockwise (default counter-clockwise)
-  --model NAME         controller model: autorally-nn | single-track | kinematic (autorally-nn)
-  --plant NAME         simulated car: single-track | autorally-nn | kinematic (single-track)
+  --model NAME         controller model: autorally-nn | single-track | kinematic | corrected
+                       (autorally-nn; corrected = nominal + effects from mppi-fit diagnose)
+  --plant NAME         simulated car: single-track | autorally-nn | kinematic | corrected
+                       (single-track)
   --speed MPS          target speed [m/s]                            (6)
   --laps N             laps to drive                                 (5)
   --max-time S         stop after S simulated seconds (default: from the laps)
@@ -26,8 +28,8 @@ const char* kUsage = R"(usage: mppi-sim [options]
   --seed N             noise seed                                    (1)
   --threads N          CPU threads, 0 = all                          (0)
   --cost-config FILE   AutoRally cost weights (YAML)
-  --plant-params FILE  single-track plant parameters (YAML)
-  --model-params FILE  physics controller-model parameters (YAML)
+  --plant-params FILE  single-track plant parameters (YAML; corrected-model file for corrected)
+  --model-params FILE  physics controller-model parameters (YAML; corrected-model file for corrected)
   --network FILE       AutoRally network (.npz)
   --out DIR            write DIR/log.csv, DIR/track.png, DIR/summary.json (default out/sim)
   --json               print summary.json to stdout

@@ -11,6 +11,7 @@
 #include "costs/cost_config.hpp"
 #include "costs/cost_map.hpp"
 #include "dynamics/autorally_nn.hpp"
+#include "dynamics/corrected_single_track.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
 #include "dynamics/single_track.hpp"
 #include "dynamics/vehicle_params.hpp"
@@ -80,9 +81,27 @@ ControllerSetup make_controller(const ClosedLoopConfig& config, const AutoRallyC
       mx[state::kY] -= l_r * std::sin(px[state::kYaw]);
       mx[state::kVy] = 0.f;
     };
+  } else if (config.model == "corrected") {
+    // Nominal + fitted effects (mppi-fit diagnose); a corrected plant shares its state layout.
+    if (config.model_params_yaml.empty()) throw Error("--model corrected needs --model-params FILE");
+    const CorrectedModelFile file = load_corrected_model(config.model_params_yaml);
+    const CorrectedSingleTrack model(file.nominal, file.effects);
+    setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
+    setup.model_states = CorrectedSingleTrack::kNx;
+    const float radius = static_cast<float>(file.nominal.wheel_radius_m);
+    setup.observe = [radius](const float* px, int plant_states, float* mx) {
+      if (plant_states == CorrectedSingleTrack::kNx) {
+        std::copy(px, px + CorrectedSingleTrack::kNx, mx);
+      } else {
+        std::fill(mx, mx + CorrectedSingleTrack::kNx, 0.f);
+        std::copy(px, px + std::min(plant_states, int{SingleTrack::kNx}), mx);
+        if (plant_states != SingleTrack::kNx)
+          mx[SingleTrack::kOmegaFront] = mx[SingleTrack::kOmegaRear] = px[state::kVx] / radius;
+      }
+    };
   } else {
     throw Error("unknown controller model '" + config.model +
-                "' (valid: autorally-nn, single-track, kinematic)");
+                "' (valid: autorally-nn, single-track, kinematic, corrected)");
   }
   return setup;
 }
@@ -252,7 +271,13 @@ RunSummary run_closed_loop(const ClosedLoopConfig& config) {
                                                                             : config.network_npz),
                           track, cost);
   if (config.plant == "kinematic") return run_with_plant(config, KinematicBicycle(), track, cost);
-  throw Error("unknown plant '" + config.plant + "' (valid: single-track, autorally-nn, kinematic)");
+  if (config.plant == "corrected") {
+    if (config.plant_params_yaml.empty()) throw Error("--plant corrected needs --plant-params FILE");
+    const CorrectedModelFile file = load_corrected_model(config.plant_params_yaml);
+    return run_with_plant(config, CorrectedSingleTrack(file.nominal, file.effects), track, cost);
+  }
+  throw Error("unknown plant '" + config.plant +
+              "' (valid: single-track, autorally-nn, kinematic, corrected)");
 }
 
 }  // namespace mppi::sim
