@@ -14,7 +14,8 @@
 //   m^s dV_z      = sum F_i
 //   I^P_y ddtheta = sum -x_i F_i + m^s g h^s theta - m^s a_x h^s
 //   I^R_x ddphi   = sum y_i F_i + m^s g (h^s - h^c) phi + m^s a_y (h^s - h^c)
-// with a_x, a_y the body-frame acceleration of the car (tyre forces + resistances) / m. This
+// with a_x, a_y the body-frame tyre force sums / m (rolling resistance and drag are left out
+// of a_x here, as in the double-track's load transfer, so that the stiff limit holds). This
 // is the paper's (FullVehicle4)-(FullVehicle6) with consistent signs (the paper's heave line
 // has theta for z) and sin, cos linearised. Drag: m dVx gets -C_D rho A Vx |Vx| / 2 (the
 // paper writes it outside the 1/m).
@@ -77,7 +78,8 @@ template <class T>
 struct FullVehicleTerms {
   FourWheelTerms<T> planar;     // tyres, loads, planar accelerations, wheel spin
   T suspension_force_N[4];      // F_i on the body, relative to the static preload
-  T ax_mps2, ay_mps2;           // acceleration of the car, body frame (without Vy r, -Vx r)
+  T ax_mps2, ay_mps2;           // acceleration of the car (all forces / m), body frame, as an
+                                // accelerometer at the CG reads it (without gravity)
   T dheave_rate_mps2, dpitch_rate_radps2, droll_rate_radps2;
 };
 using FullVehicleForces = FullVehicleTerms<double>;
@@ -102,8 +104,11 @@ inline void full_vehicle_terms(const FullVehicleCoeffs<T>& k, T vx, T vy, T r, c
   e->ax_mps2 = (e->planar.body_fx_N + e->planar.resist_force_N) * k.planar.inv_mass;
   e->ay_mps2 = e->planar.body_fy_N * k.planar.inv_mass;
   e->dheave_rate_mps2 = sum_f * k.inv_sprung_mass;
+  // The pitch excitation is the tyre forces' part of a_x (the same ground forces whose moment
+  // the double-track transfers): rolling resistance and drag do not pitch the body here.
   e->dpitch_rate_radps2 =
-      (pitch_moment + k.pitch_gravity * pitch - k.pitch_arm * e->ax_mps2) * k.inv_pitch_inertia;
+      (pitch_moment + k.pitch_gravity * pitch - k.pitch_arm * e->planar.body_fx_N * k.planar.inv_mass) *
+      k.inv_pitch_inertia;
   e->droll_rate_radps2 =
       (roll_moment + k.roll_gravity * roll + k.roll_arm * e->ay_mps2) * k.inv_roll_inertia;
 }
