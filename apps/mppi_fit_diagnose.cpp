@@ -39,7 +39,7 @@ const char* kUsage = R"(usage:
     --out DIR           report.json, report.md, PNG plots, corrected_model.yaml (out/diagnose)
     --no-plots          skip the PNG plots
   mppi-fit diagnose synth --out FILE.csv [--effect key=value,...] [--seed N] [--duration S]
-                          [--speed V] [--samples K] [--track NAME]
+                          [--speed V] [--samples K] [--track NAME] [--noise-scale F]
   mppi-fit diagnose sweep [--seeds N] [--sizes small,large] [--effects A,B,...] [--clean N]
                           [--duration S] [--out DIR]
   mppi-fit diagnose loop --truth key=value,... --model-params FILE [--laps N] [--speed V]
@@ -132,6 +132,7 @@ int cmd_synth(int argc, char** argv) {
     else if (f == "--speed") o.target_speed_mps = number(f, value());
     else if (f == "--samples") o.samples = static_cast<int>(number(f, value()));
     else if (f == "--track") o.track = value();
+    else if (f == "--noise-scale") o.noise.scale = number(f, value());
     else throw UsageError("unknown option " + f);
   }
   if (out.empty()) throw UsageError("synth: --out FILE.csv is required");

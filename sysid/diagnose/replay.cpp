@@ -35,17 +35,43 @@ void predict_segment(const CorrectedSingleTrack& model, const DiagData& d, const
   vs.yaw_rate_radps = static_cast<float>(d.r[k0]);
   model.init_state(vs, x);
   x[CorrectedSingleTrack::kTime] = static_cast<float>(d.t[k0]);
-  // Actuator chains: start from the command held at the beginning of the history, then run
-  // the recorded commands through them up to the start.
+  // Unmeasured states (actuator chains, wheel speeds): run the model over the history before
+  // the start with its measured states forced back to the recording at every sample, so that
+  // they settle where this model puts them; then start from the measured state.
   std::size_t h = k0;
   const int prime_rows = static_cast<int>(std::lround(o.prime_s / d.dt_s));
   for (int i = 0; i < prime_rows && h > 0 && d.piece[h - 1] == d.piece[k0]; ++i) --h;
   CorrectedSingleTrack::set_actuators(x, static_cast<float>(d.steer_over(h)),
                                       static_cast<float>(d.throttle_over(h)));
-  for (std::size_t k = h; k < k0; ++k)
-    model.advance_actuators(x, static_cast<float>(d.steer_over(k)), static_cast<float>(d.throttle_over(k)),
-                            static_cast<float>(d.t[k + 1] - d.t[k]));
+  // Velocities: a constant-gain observer (blend of the model's value and the measurement) once
+  // the full model runs, which takes sensor noise off the start state; the rest measured.
+  bool observing = false;
+  auto force_measured = [&](std::size_t k) {
+    x[state::kX] = static_cast<float>(d.x[k]);
+    x[state::kY] = static_cast<float>(d.y[k]);
+    x[state::kYaw] = static_cast<float>(d.yaw[k]);
+    const float g = observing ? static_cast<float>(o.observer_gain) : 1.f;
+    x[state::kVx] += g * (static_cast<float>(d.vx[k]) - x[state::kVx]);
+    x[state::kVy] += g * (static_cast<float>(d.vy[k]) - x[state::kVy]);
+    x[state::kYawRate] += g * (static_cast<float>(d.r[k]) - x[state::kYawRate]);
+    x[CorrectedSingleTrack::kTime] = static_cast<float>(d.t[k]);
+  };
   float u[2];
+  for (std::size_t k = h; k < k0; ++k) {
+    force_measured(k);
+    const double dt = d.t[k + 1] - d.t[k];
+    const int n = std::max(1, static_cast<int>(std::lround(dt / o.substep_s)));
+    u[0] = static_cast<float>(d.steer_over(k));
+    u[1] = static_cast<float>(d.throttle_over(k));
+    if (static_cast<double>(k0 - k) * d.dt_s > o.wheel_prime_s) {  // actuators only
+      model.advance_actuators(x, u[0], u[1], static_cast<float>(dt));
+      continue;
+    }
+    for (int j = 0; j < n; ++j)
+      model.step<1>(Batch<CorrectedSingleTrack::kNx, 1>{x}, ConstBatch<2, 1>{u}, static_cast<float>(dt / n), nullptr);
+    observing = true;
+  }
+  force_measured(k0);
   for (int i = 0; i < s.len; ++i) {
     const std::size_t k = k0 + static_cast<std::size_t>(i);
     const double dt = d.t[k + 1] - d.t[k];

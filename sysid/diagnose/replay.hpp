@@ -22,6 +22,8 @@ std::vector<Segment> make_segments(const DiagData& d, const std::vector<char>& m
 struct ReplayOptions {
   double substep_s = 0.002;  // integration step inside a sample interval [s] (the simulator's)
   double prime_s = 0.6;      // command history run through the actuator chains before a start [s]
+  double wheel_prime_s = 0.3;  // of which the last part runs the full model (wheel speeds) [s]
+  double observer_gain = 0.5;  // blend towards the measured velocities per sample there (1 = raw)
 };
 
 // Predicted vx, vy, yaw rate (and x, y) along a segment: out[(i - 1) * 5 + c] for i = 1..len,

@@ -93,7 +93,7 @@ int synthesize(const SynthOptions& o, const std::string& csv_path) {
 
   const sim::Recording raw = sim::RecordingReader::read(c.out_dir + "/log.csv");
   std::mt19937_64 rng(o.seed * 7919 + 17);
-  std::normal_distribution<double> n01(0.0, 1.0);
+  std::normal_distribution<double> n01(0.0, o.noise.scale);
   std::string ids;
   for (const auto& id : o.truth_ids) ids += (ids.empty() ? "" : " ") + id;
   sim::RecordingWriter w(csv_path, {"applied_steer", "applied_throttle"},

@@ -18,6 +18,7 @@ struct SensorNoise {
   double vx_mps = 0.05;
   double vy_mps = 0.03;
   double yaw_rate_radps = 0.02; // gyro
+  double scale = 1.0;           // multiplies all of the above (0 = noise-free)
 };
 
 struct SynthOptions {
