@@ -221,6 +221,10 @@ class FullVehicle {
 
   // Suspension forces, tyre velocities, slips, loads and forces at (x, u), in double.
   FullVehicleForces forces(const double* x, const double* u) const noexcept { return terms(kd_, x, u); }
+  static FullVehicleForces forces(const FullVehicleCoeffs<double>& k, const double* x,
+                                  const double* u) noexcept {
+    return terms(k, x, u);
+  }
 
   // One step of the same integrator as step(), in double (for estimators and references).
   static void step_double(const FullVehicleCoeffs<double>& k, double* x, const double* u,
