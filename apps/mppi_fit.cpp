@@ -11,6 +11,7 @@ commands:
   estimate   estimate model parameters from a recording (UKF, joint UKF, ALM-UKF)
   convert    convert a shipped real-data recording into the project's recording format
   diagnose   compare a recording against the simulator's prediction (sim vs real)
+  protocol   simulate the paper's estimation manoeuvres on the full-vehicle plant
 )";
 
 }  // namespace
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
   if (std::strcmp(cmd, "estimate") == 0) return mppi_fit_estimate(argc - 1, argv + 1);
   if (std::strcmp(cmd, "convert") == 0) return mppi_fit_convert(argc - 1, argv + 1);
   if (std::strcmp(cmd, "diagnose") == 0) return mppi_fit_diagnose(argc - 1, argv + 1);
+  if (std::strcmp(cmd, "protocol") == 0) return mppi_fit_protocol(argc - 1, argv + 1);
   std::fprintf(stderr, "mppi-fit: unknown command '%s'\n%s", cmd, kUsage);
   return 2;
 }
