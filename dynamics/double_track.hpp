@@ -110,12 +110,13 @@ using FourWheelForces = FourWheelTerms<double>;
 
 // The planar right-hand side. `extra_load` (may be null) adds e_i to the loads. Branch-free.
 template <class T>
-inline void four_wheel_terms(const FourWheelCoeffs<T>& k, T vx, T vy, T r, const T* omega, T steer,
+[[gnu::always_inline]] inline void four_wheel_terms(const FourWheelCoeffs<T>& k, T vx, T vy, T r, const T* omega, T steer,
                              T throttle, const T* extra_load, FourWheelTerms<T>* e) noexcept {
   e->delta_rad = std::min(std::max(steer, T(-1)), T(1)) * k.max_steer;
   T sd, cd;
   phys::sincos(e->delta_rad, &sd, &cd);
   T mbx[4], mby[4];  // friction per unit load, body frame
+  #pragma GCC unroll 4
   for (int i = 0; i < 4; ++i) {
     const T cvx = vx - r * k.pos_y[i];  // contact-point velocity, body frame
     const T cvy = vy + r * k.pos_x[i];
@@ -130,6 +131,7 @@ inline void four_wheel_terms(const FourWheelCoeffs<T>& k, T vx, T vy, T r, const
   // Fx = sum mbx_i (c_i + a_i Fx + b_i Fy), Fy = sum mby_i (...): 2x2 solve (Cramer).
   T a11 = T(1), a12 = T(0), a21 = T(0), a22 = T(1), b1 = T(0), b2 = T(0);
   T base[4];
+  #pragma GCC unroll 4
   for (int i = 0; i < 4; ++i) {
     base[i] = k.static_load[i] + (extra_load ? extra_load[i] : T(0));
     a11 -= mbx[i] * k.load_per_fx[i];
@@ -144,6 +146,7 @@ inline void four_wheel_terms(const FourWheelCoeffs<T>& k, T vx, T vy, T r, const
   const T fx_sum = (b1 * a22 - a12 * b2) * inv_det;
   const T fy_sum = (a11 * b2 - a21 * b1) * inv_det;
   T body_fx = T(0), body_fy = T(0), yaw_moment = T(0);
+  #pragma GCC unroll 4
   for (int i = 0; i < 4; ++i) {
     const T fz = base[i] + k.load_per_fx[i] * fx_sum + k.load_per_fy[i] * fy_sum;
     e->fz_N[i] = std::min(std::max(fz, T(0)), k.weight);
@@ -163,10 +166,28 @@ inline void four_wheel_terms(const FourWheelCoeffs<T>& k, T vx, T vy, T r, const
   e->dvx_mps2 = (body_fx + e->resist_force_N) * k.inv_mass + vy * r;
   e->dvy_mps2 = body_fy * k.inv_mass - vx * r;
   e->dyaw_rate_radps2 = yaw_moment * k.inv_yaw_inertia;
+  #pragma GCC unroll 4
   for (int i = 0; i < 4; ++i) {
     const T torque = i < 2 ? T(0) : T(0.5) * e->drive_torque_Nm;
     e->domega_radps2[i] = (torque - e->fx_N[i] * k.radius) * k.inv_wheel_inertia[i];
   }
+}
+
+// The accelerations only, from scalar wheel speeds: what the batched step needs. Keeping the
+// terms struct (arrays) out of the omp-simd loop body lets GCC vectorise the lane loop.
+template <class T>
+struct FourWheelRates {
+  T dvx, dvy, dr, dw0, dw1, dw2, dw3;
+};
+template <class T>
+[[gnu::always_inline]] inline FourWheelRates<T> four_wheel_rates(const FourWheelCoeffs<T>& k, T vx, T vy, T r,
+                                                                  T w0, T w1, T w2, T w3, T steer,
+                                                                  T throttle) noexcept {
+  const T omega[4] = {w0, w1, w2, w3};
+  FourWheelTerms<T> e;
+  four_wheel_terms<T>(k, vx, vy, r, omega, steer, throttle, nullptr, &e);
+  return {e.dvx_mps2, e.dvy_mps2, e.dyaw_rate_radps2, e.domega_radps2[0], e.domega_radps2[1],
+          e.domega_radps2[2], e.domega_radps2[3]};
 }
 
 inline FourWheelCoeffs<double> double_track_coeffs(const DoubleTrackParams& p) noexcept {
@@ -212,21 +233,20 @@ class DoubleTrack {
     MPPI_SIMD_LOOP
     for (int j = 0; j < W; ++j) {
       const float vx = pvx[j], vy = pvy[j], r = pr[j];
-      const float omega[4] = {pw0[j], pw1[j], pw2[j], pw3[j]};
-      FourWheelTerms<float> e;
-      four_wheel_terms<float>(k, vx, vy, r, omega, ps[j], pt[j], nullptr, &e);
+      const FourWheelRates<float> d =
+          four_wheel_rates<float>(k, vx, vy, r, pw0[j], pw1[j], pw2[j], pw3[j], ps[j], pt[j]);
       float sy, cy;
       fast_sincos(pyaw[j], &sy, &cy);
       px[j] += (cy * vx - sy * vy) * dt_s;
       py[j] += (sy * vx + cy * vy) * dt_s;
       pyaw[j] += r * dt_s;
-      pvx[j] = vx + e.dvx_mps2 * dt_s;
-      pvy[j] = vy + e.dvy_mps2 * dt_s;
-      pr[j] = r + e.dyaw_rate_radps2 * dt_s;
-      pw0[j] += e.domega_radps2[0] * dt_s;
-      pw1[j] += e.domega_radps2[1] * dt_s;
-      pw2[j] += e.domega_radps2[2] * dt_s;
-      pw3[j] += e.domega_radps2[3] * dt_s;
+      pvx[j] = vx + d.dvx * dt_s;
+      pvy[j] = vy + d.dvy * dt_s;
+      pr[j] = r + d.dr * dt_s;
+      pw0[j] += d.dw0 * dt_s;
+      pw1[j] += d.dw1 * dt_s;
+      pw2[j] += d.dw2 * dt_s;
+      pw3[j] += d.dw3 * dt_s;
     }
   }
 

@@ -86,10 +86,11 @@ using FullVehicleForces = FullVehicleTerms<double>;
 
 // Right-hand side of the whole model, given roll, pitch, heave and their rates. Branch-free.
 template <class T>
-inline void full_vehicle_terms(const FullVehicleCoeffs<T>& k, T vx, T vy, T r, const T* omega,
+[[gnu::always_inline]] inline void full_vehicle_terms(const FullVehicleCoeffs<T>& k, T vx, T vy, T r, const T* omega,
                                T roll, T pitch, T heave, T roll_rate, T pitch_rate, T heave_rate,
                                T steer, T throttle, FullVehicleTerms<T>* e) noexcept {
   T sum_f = T(0), pitch_moment = T(0), roll_moment = T(0);
+  #pragma GCC unroll 4
   for (int i = 0; i < 4; ++i) {
     const T x = k.planar.pos_x[i], y = k.planar.pos_y[i];
     const T dz = heave - x * pitch + y * roll;
@@ -111,6 +112,24 @@ inline void full_vehicle_terms(const FullVehicleCoeffs<T>& k, T vx, T vy, T r, c
       k.inv_pitch_inertia;
   e->droll_rate_radps2 =
       (roll_moment + k.roll_gravity * roll + k.roll_arm * e->ay_mps2) * k.inv_roll_inertia;
+}
+
+// The rates the batched step needs, from scalars (keeps arrays out of the omp-simd loop body).
+template <class T>
+struct FullVehicleRates {
+  T dvx, dvy, dr, dw0, dw1, dw2, dw3, droll_rate, dpitch_rate, dheave_rate;
+};
+template <class T>
+[[gnu::always_inline]] inline FullVehicleRates<T> full_vehicle_rates(
+    const FullVehicleCoeffs<T>& k, T vx, T vy, T r, T w0, T w1, T w2, T w3, T roll, T pitch, T heave,
+    T roll_rate, T pitch_rate, T heave_rate, T steer, T throttle) noexcept {
+  const T omega[4] = {w0, w1, w2, w3};
+  FullVehicleTerms<T> e;
+  full_vehicle_terms<T>(k, vx, vy, r, omega, roll, pitch, heave, roll_rate, pitch_rate, heave_rate,
+                        steer, throttle, &e);
+  return {e.planar.dvx_mps2, e.planar.dvy_mps2, e.planar.dyaw_rate_radps2,
+          e.planar.domega_radps2[0], e.planar.domega_radps2[1], e.planar.domega_radps2[2],
+          e.planar.domega_radps2[3], e.droll_rate_radps2, e.dpitch_rate_radps2, e.dheave_rate_mps2};
 }
 
 class FullVehicle {
@@ -159,25 +178,24 @@ class FullVehicle {
     MPPI_SIMD_LOOP
     for (int j = 0; j < W; ++j) {
       const float vx = pvx[j], vy = pvy[j], r = pr[j];
-      const float omega[4] = {pw0[j], pw1[j], pw2[j], pw3[j]};
-      FullVehicleTerms<float> e;
-      full_vehicle_terms<float>(k, vx, vy, r, omega, proll[j], ppitch[j], pz[j], proll_rate[j],
-                                ppitch_rate[j], pz_rate[j], ps[j], pt[j], &e);
+      const FullVehicleRates<float> e =
+          full_vehicle_rates<float>(k, vx, vy, r, pw0[j], pw1[j], pw2[j], pw3[j], proll[j], ppitch[j],
+                                    pz[j], proll_rate[j], ppitch_rate[j], pz_rate[j], ps[j], pt[j]);
       float sy, cy;
       fast_sincos(pyaw[j], &sy, &cy);
       px[j] += (cy * vx - sy * vy) * dt_s;
       py[j] += (sy * vx + cy * vy) * dt_s;
       pyaw[j] += r * dt_s;
-      pvx[j] = vx + e.planar.dvx_mps2 * dt_s;
-      pvy[j] = vy + e.planar.dvy_mps2 * dt_s;
-      pr[j] = r + e.planar.dyaw_rate_radps2 * dt_s;
-      pw0[j] += e.planar.domega_radps2[0] * dt_s;
-      pw1[j] += e.planar.domega_radps2[1] * dt_s;
-      pw2[j] += e.planar.domega_radps2[2] * dt_s;
-      pw3[j] += e.planar.domega_radps2[3] * dt_s;
-      const float roll_rate = proll_rate[j] + e.droll_rate_radps2 * dt_s;
-      const float pitch_rate = ppitch_rate[j] + e.dpitch_rate_radps2 * dt_s;
-      const float heave_rate = pz_rate[j] + e.dheave_rate_mps2 * dt_s;
+      pvx[j] = vx + e.dvx * dt_s;
+      pvy[j] = vy + e.dvy * dt_s;
+      pr[j] = r + e.dr * dt_s;
+      pw0[j] += e.dw0 * dt_s;
+      pw1[j] += e.dw1 * dt_s;
+      pw2[j] += e.dw2 * dt_s;
+      pw3[j] += e.dw3 * dt_s;
+      const float roll_rate = proll_rate[j] + e.droll_rate * dt_s;
+      const float pitch_rate = ppitch_rate[j] + e.dpitch_rate * dt_s;
+      const float heave_rate = pz_rate[j] + e.dheave_rate * dt_s;
       proll_rate[j] = roll_rate;
       ppitch_rate[j] = pitch_rate;
       pz_rate[j] = heave_rate;
