@@ -11,6 +11,7 @@
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"
 #include "sysid/protocol.hpp"
+#include "sysid/protocol_plot.hpp"
 
 namespace {
 
@@ -18,7 +19,8 @@ const char* kProtocolUsage = R"(usage: mppi-fit protocol [options]
 Drives the simulated full-vehicle plant (known parameters) through the paper's five manoeuvres
 (low speed, zig-zag, straight acceleration and braking, sliding, high speed; 20 s each) and a
 held-out 13 s lap-like segment, with sensor noise. Writes DIR/train.csv, DIR/validation.csv
-(measured, docs/RECORDING_FORMAT.md), DIR/truth.csv (noise-free states), DIR/truth.yaml.
+(measured, docs/RECORDING_FORMAT.md), DIR/truth.csv (noise-free states), DIR/truth.yaml,
+DIR/protocol.png.
   --params FILE       full-vehicle parameters of the plant (default data/config/autorally_full_vehicle.yaml)
   --out DIR           output folder (default out/protocol)
   --seed N            sensor-noise seed (1)
@@ -75,7 +77,8 @@ int mppi_fit_protocol(int argc, char** argv) {
         params_path.empty() ? mppi::sim::data_file("config/autorally_full_vehicle.yaml") : params_path);
     const auto run = mppi::sysid::run_protocol(params, options);
     mppi::sysid::write_protocol(run, params, out);
-    std::printf("protocol: %zu training rows, %zu validation rows -> %s/{train,validation,truth}.csv, truth.yaml\n",
+    mppi::sysid::plot_protocol(run, out + "/protocol.png");
+    std::printf("protocol: %zu training rows, %zu validation rows -> %s/{train,validation,truth}.csv, truth.yaml, protocol.png\n",
                 run.training.rows(), run.validation.rows(), out.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mppi-fit protocol: %s\n", e.what());
