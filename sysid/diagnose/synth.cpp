@@ -9,6 +9,7 @@
 
 #include "mppi/error.hpp"
 #include "sim/closed_loop.hpp"
+#include "sim/plant.hpp"
 #include "sim/recording.hpp"
 #include "sysid/diagnose/effects.hpp"
 
@@ -55,12 +56,54 @@ const std::vector<SweepCase>& sweep_cases() {
       {"steer_offset", "steer_offset=0.03", "steer_offset=0.1"},
       {"steer_gain", "steer_gain=0.85", "steer_gain=0.65"},
       {"tire_saturation", "tyre_peak_scale=0.8", "tyre_peak_scale=0.6"},
-      {"friction_change", "grip_change_time_s=25,grip_scale=0.8", "grip_change_time_s=25,grip_scale=0.6"},
+      {"friction_change", "grip_change_time_s=15,grip_scale=0.8", "grip_change_time_s=15,grip_scale=0.6"},
       {"load_transfer", "cg_height_delta_m=0.05", "cg_height_delta_m=0.1"},
       {"motor_voltage_sag", "voltage_sag=0.15", "voltage_sag=0.35"},
       {"road_grade", "grade_x=0.03", "grade_x=0.08"},
   };
   return cases;
+}
+
+sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t seed, double duration_s,
+                                    const SensorNoise& noise) {
+  sim::ActuatorLimits fast;
+  fast.steer_rate_per_s = fast.throttle_rate_per_s = 1e4f;
+  sim::Plant<CorrectedSingleTrack> plant(CorrectedSingleTrack(SingleTrackParams{}, truth), fast, 0.002f);
+  VehicleState s0;
+  s0.vx_mps = 4.f;
+  plant.reset(s0);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  std::normal_distribution<double> n01(0.0, noise.scale);
+  sim::Recording rec;
+  rec.metadata = {{"source", "mppi-fit synth (open loop)"}, {"seed", std::to_string(seed)}};
+  rec.columns = {sim::kRecordingRequiredColumns.begin(), sim::kRecordingRequiredColumns.end()};
+  rec.data.assign(rec.columns.size(), {});
+  Control cmd;
+  double hold = 0;
+  const int steps = static_cast<int>(std::lround(duration_s / 0.02));
+  for (int k = 1; k <= steps; ++k) {
+    if ((hold -= 0.02) <= 0) {  // new random command
+      hold = 0.1 + 0.4 * uni(rng);
+      const double v = plant.vehicle_state().vx_mps;
+      cmd.steer = static_cast<float>((uni(rng) < 0.2 ? 0.9 : 0.45) * (2 * uni(rng) - 1));
+      const double base = v < 3 ? 0.6 : v > 9 ? -0.2 : 0.35;
+      cmd.throttle = static_cast<float>(std::clamp(base + 0.5 * (2 * uni(rng) - 1), -0.8, 0.9));
+    }
+    plant.advance(cmd, 0.02f);
+    const VehicleState s = plant.vehicle_state();
+    const double row[] = {0.02 * k,
+                          s.x_m + noise.position_m * n01(rng),
+                          s.y_m + noise.position_m * n01(rng),
+                          s.yaw_rad + noise.yaw_rad * n01(rng),
+                          s.vx_mps + noise.vx_mps * n01(rng),
+                          s.vy_mps + noise.vy_mps * n01(rng),
+                          s.yaw_rate_radps + noise.yaw_rate_radps * n01(rng),
+                          cmd.steer,
+                          cmd.throttle};
+    for (std::size_t c = 0; c < rec.columns.size(); ++c) rec.data[c].push_back(row[c]);
+  }
+  return rec;
 }
 
 int synthesize(const SynthOptions& o, const std::string& csv_path) {

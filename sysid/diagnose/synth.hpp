@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "dynamics/corrected_single_track.hpp"
+#include "sim/recording.hpp"
 
 namespace mppi::diagnose {
 
@@ -37,6 +38,12 @@ struct SynthOptions {
 
 // Writes the recording to `csv_path`. Returns the number of crashes during the run.
 int synthesize(const SynthOptions& o, const std::string& csv_path);
+
+// A fast open-loop variant for tests: the truth plant (500 Hz, no slew limits) driven on open
+// ground by random steering and throttle (held 0.1-0.5 s, speed kept in about 3-9 m/s), logged at
+// 50 Hz with sensor noise, in the recording format (metadata source "mppi-fit synth").
+sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t seed, double duration_s,
+                                    const SensorNoise& noise = {});
 
 // Parses "key=value,key=value" (EffectParams field names, as in the corrected-model file) into
 // `e`; returns the effect ids the keys belong to. Throws mppi::Error for an unknown key.
