@@ -305,3 +305,30 @@ TEST_CASE("Double-track parameters: YAML file, round trip, errors", "[physics][d
   CHECK_THAT(error_of([] { DoubleTrackParams q; q.lateral_load_transfer = 2; DoubleTrack{q}; }),
              Catch::Contains("lateral_load_transfer"));
 }
+
+TEST_CASE("Double-track at the controller's 0.02 s stays finite and bounded", "[physics][double_track]") {
+  // Random controls held for 0.1 s, 2000 steps per lane, from random sliding states.
+  const DoubleTrack dt{DoubleTrackParams{}};
+  constexpr int W = mppi::kChunk;
+  constexpr int N = DoubleTrack::kNx;
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> U(-1, 1);
+  std::array<float, N * W> xb{};
+  std::array<float, 2 * W> ub{};
+  for (int j = 0; j < W; ++j) {
+    const State s = random_state(rng);
+    for (int i = 0; i < N; ++i) xb[i * W + j] = static_cast<float>(s[i]);
+  }
+  bool ok = true;
+  for (int n = 0; n < 2000; ++n) {
+    if (n % 5 == 0)
+      for (auto& v : ub) v = static_cast<float>(U(rng));
+    dt.step<W>(mppi::Batch<N, W>{xb.data()}, mppi::ConstBatch<2, W>{ub.data()}, 0.02f, nullptr);
+    for (int j = 0; j < W; ++j) {
+      ok &= std::isfinite(xb[st::kVx * W + j]) && std::abs(xb[st::kVx * W + j]) < 40;
+      ok &= std::abs(xb[st::kYawRate * W + j]) < 20;
+      for (int i = 0; i < 4; ++i) ok &= std::abs(xb[(DoubleTrack::kOmega + i) * W + j]) < 500;
+    }
+  }
+  CHECK(ok);
+}
