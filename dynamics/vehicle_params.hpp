@@ -6,6 +6,7 @@
 // plausible for a 22 kg 1:5 rally car and are meant to be calibrated.
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "dynamics/pacejka.hpp"
 
@@ -137,6 +138,15 @@ DoubleTrackParams load_double_track_params(const std::string& path);
 FullVehicleParams load_full_vehicle_params(const std::string& path);
 DoubleTrackParams double_track_params_from_yaml(const std::string& text, const std::string& source);
 FullVehicleParams full_vehicle_params_from_yaml(const std::string& text, const std::string& source);
+// Every numeric field by its YAML key (tyre fields as "tyre.B", ...), pointing into `p`: for
+// estimators that treat a chosen set of parameters as a vector. Order as in the YAML files.
+struct NamedParam {
+  std::string key;
+  double* value;
+};
+std::vector<NamedParam> named_parameters(SingleTrackParams& p);
+std::vector<NamedParam> named_parameters(DoubleTrackParams& p);
+std::vector<NamedParam> named_parameters(FullVehicleParams& p);
 // A YAML document of every field (same keys as the loaders), e.g. for estimated parameters.
 std::string to_yaml(const SingleTrackParams& p);
 std::string to_yaml(const DoubleTrackParams& p);

@@ -197,6 +197,19 @@ FullVehicleParams load_full_vehicle_params(const std::string& path) {
   return full_vehicle_params_from_yaml(read_file(path, "full-vehicle parameter"), path);
 }
 
+namespace {
+std::vector<NamedParam> named(const std::vector<Field>& fields, PacejkaParams& tyre) {
+  std::vector<NamedParam> out;
+  for (const auto& f : fields) out.push_back({f.key, f.value});
+  for (const auto& f : tyre_fields(tyre)) out.push_back({std::string("tyre.") + f.key, f.value});
+  return out;
+}
+}  // namespace
+
+std::vector<NamedParam> named_parameters(SingleTrackParams& p) { return named(single_track_fields(p), p.tyre); }
+std::vector<NamedParam> named_parameters(DoubleTrackParams& p) { return named(double_track_fields(p), p.base.tyre); }
+std::vector<NamedParam> named_parameters(FullVehicleParams& p) { return named(full_vehicle_fields(p), p.base.tyre); }
+
 std::string to_yaml(const SingleTrackParams& p) {
   SingleTrackParams c = p;
   return fields_to_yaml(single_track_fields(c), tyre_fields(c.tyre));

@@ -350,6 +350,19 @@ TEST_CASE("Full-vehicle parameters: YAML file, round trip, errors", "[physics][f
   CHECK(back.front_damper_Nspm == 77.0);
   CHECK(back.base.yaw_inertia_kgm2 == 1.0);
 
+  // Named access covers every YAML key and points into the struct.
+  FullVehicleParams named;
+  int found = 0;
+  for (const auto& np : mppi::named_parameters(named)) {
+    if (np.key == "front_spring_Npm") *np.value = 1234.0, ++found;
+    if (np.key == "tyre.Sv") *np.value = 0.2, ++found;
+    CHECK(np.key != "aero_drag_kgpm");
+  }
+  CHECK(found == 2);
+  CHECK(named.front_spring_Npm == 1234.0);
+  CHECK(named.base.tyre.Sv == 0.2);
+  CHECK(mppi::named_parameters(named).size() == 16 + 15 + 6);
+
   using mppi::test::error_of;
   CHECK_THAT(error_of([] { mppi::full_vehicle_params_from_yaml("aero_drag_kgpm: 0.05\n", "fv.yaml"); }),
              Catch::Contains("fv.yaml:1") && Catch::Contains("aero_drag_kgpm"));
