@@ -14,7 +14,14 @@ bool AlmSettings::is_valid(std::string* why) const {
   if (window < 3) return fail("alm window must be >= 3");
   if (min_samples < 3 || min_samples > window) return fail("alm min_samples must be in [3, window]");
   if (!(min_eigenvalue > 0 && std::isfinite(min_eigenvalue))) return fail("alm min_eigenvalue must be > 0");
+  if (!(relative_floor > 0 && relative_floor < 1)) return fail("alm relative_floor must be in (0, 1)");
   return true;
+}
+
+Mat nearest_positive_definite_scaled(const Mat& A, const Vec& s, double floor) {
+  const Vec inv = s.cwiseInverse();
+  const Mat scaled = inv.asDiagonal() * A * inv.asDiagonal();
+  return s.asDiagonal() * nearest_positive_definite(scaled, floor) * s.asDiagonal();
 }
 
 bool JointFilterSettings::is_valid(std::string* why) const {
@@ -137,6 +144,9 @@ JointStateFilter::JointStateFilter(JointModel model, const JointFilterSettings& 
   impose_param_noise(q, Q);
   ukf_.set_process_noise(q, Q);
   ukf_.set_measurement_noise(Vec::Zero(model_.ny), R);
+  q_scale_ = Q.diagonal().cwiseMax(1e-30).cwiseSqrt();
+  q_scale_.tail(np).setOnes();  // the parameter block is not estimated (re-imposed each step)
+  r_scale_ = R.diagonal().cwiseMax(1e-30).cwiseSqrt();
 }
 
 void JointStateFilter::impose_param_noise(Vec& q, Mat& Q) const {
@@ -148,8 +158,19 @@ void JointStateFilter::impose_param_noise(Vec& q, Mat& Q) const {
 }
 
 void JointStateFilter::step(const Vec& u_prev, const Vec& y, const Vec& u) {
+  const Vec x_before = ukf_.x();
+  const Mat P_before = ukf_.P();
   const PredictInfo pred = ukf_.predict(u_prev);  // copy: the next predict overwrites it
   last_update_ = ukf_.update(y, u);
+  if (!ukf_.x().allFinite() || !ukf_.P().allFinite()) {
+    // A diverged step (e.g. sigma points far outside the model's range): undo it, widen P a
+    // little so that the next measurement can pull the state back.
+    ukf_.x() = x_before;
+    ukf_.P() = P_before + ukf_.Q();
+    last_update_ = UpdateInfo{};
+    ++rejected_;
+    return;
+  }
   if (!settings_.adaptive) return;
   const bool measured = !last_update_.rows.empty();
   if (measured && settings_.alm.estimate_process) alm_.add_process_sample(ukf_.x(), ukf_.P(), pred);
@@ -157,15 +178,22 @@ void JointStateFilter::step(const Vec& u_prev, const Vec& y, const Vec& u) {
   if (settings_.alm.estimate_process && alm_.process_ready()) {
     bool projected = false;
     Vec q = settings_.alm.estimate_means ? alm_.q_hat() : ukf_.q();
-    Mat Q = alm_.Q_hat(&projected);
+    Mat raw = alm_.Q_hat_raw();
+    const int nx = model_.nx, np = model_.np;
+    raw.block(0, nx, nx, np).setZero();
+    raw.block(nx, 0, np, nx).setZero();
+    raw.bottomRightCorner(np, np) = Mat::Identity(np, np);
+    Mat Q = nearest_positive_definite_scaled(raw, q_scale_, settings_.alm.relative_floor);
+    projected = !(Q - 0.5 * (raw + raw.transpose())).isZero(0);
     projections_ += projected;
     impose_param_noise(q, Q);
-    // The parameter block is fixed above; keep the state block positive definite after that.
-    ukf_.set_process_noise(q, nearest_positive_definite(Q, settings_.alm.min_eigenvalue));
+    ukf_.set_process_noise(q, Q);
   }
   if (settings_.alm.estimate_measurement && alm_.measurement_ready()) {
     bool projected = false;
-    const Mat R = alm_.R_hat(&projected);
+    const Mat raw = alm_.R_hat_raw();
+    const Mat R = nearest_positive_definite_scaled(raw, r_scale_, settings_.alm.relative_floor);
+    projected = !(R - 0.5 * (raw + raw.transpose())).isZero(0);
     projections_ += projected;
     ukf_.set_measurement_noise(settings_.alm.estimate_means ? alm_.r_hat() : ukf_.r(), R);
   }

@@ -31,6 +31,10 @@ struct AlmSettings {
   bool estimate_process = true;      // re-estimate q, Q
   bool estimate_measurement = true;  // re-estimate r, R
   double min_eigenvalue = 1e-10;     // floor of the projection to positive definite
+  // JointStateFilter: the projection works in coordinates scaled by the initial noise standard
+  // deviations, with eigenvalues >= relative_floor there (R^ >= 1% of the initial R per
+  // channel by default), so that no channel is ever trusted as noise-free (units differ).
+  double relative_floor = 0.01;
 
   bool is_valid(std::string* why) const;
 };
@@ -109,6 +113,7 @@ class JointStateFilter {
   const JointModel& model() const { return model_; }
   const UpdateInfo& last_update() const { return last_update_; }
   int projections() const { return projections_; }  // times Q^ or R^ had to be projected
+  int rejected_steps() const { return rejected_; }   // steps undone because the state went non-finite
 
  private:
   void impose_param_noise(Vec& q, Mat& Q) const;
@@ -119,6 +124,12 @@ class JointStateFilter {
   AlmNoiseEstimator alm_;
   UpdateInfo last_update_;
   int projections_ = 0;
+  int rejected_ = 0;
+  Vec q_scale_, r_scale_;  // initial noise standard deviations (projection coordinates)
 };
+
+// The matrix nearest to A (Frobenius norm in the coordinates A_ij / (s_i s_j)) whose scaled
+// eigenvalues are >= floor: returns S (S^-1 A S^-1 projected) S with S = diag(s).
+Mat nearest_positive_definite_scaled(const Mat& A, const Vec& s, double floor);
 
 }  // namespace mppi::sysid

@@ -85,6 +85,7 @@ ObservabilityReport observability(const TransitionFn& f, const MeasurementFn& h,
   for (int i = 0; i < n; ++i)
     if (rep.singular_values(i) > s.rank_tolerance * smax) ++rep.rank;
   rep.null_space = svd.matrixV().rightCols(n - rep.rank);
+  rep.weakest_direction = svd.matrixV().col(n - 1);
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < rep.null_space.cols(); ++j)
       if (std::abs(rep.null_space(i, j)) > s.null_component) {
@@ -97,7 +98,21 @@ ObservabilityReport observability(const TransitionFn& f, const MeasurementFn& h,
 std::string ObservabilityReport::describe(const std::vector<std::string>& names) const {
   auto name = [&](int i) { return i < static_cast<int>(names.size()) ? names[i] : "x" + std::to_string(i); };
   std::string out = "rank " + std::to_string(rank) + " of " + std::to_string(n);
-  if (full_rank()) return out + ": every state and parameter is locally identifiable";
+  if (full_rank()) {
+    out += ": every state and parameter is locally identifiable";
+    if (singular_values.size() && singular_values(0) > 0) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "\n  weakest direction (singular value ratio %.2g):",
+                    singular_values(n - 1) / singular_values(0));
+      out += buf;
+      for (int i = 0; i < n; ++i) {
+        if (std::abs(weakest_direction(i)) <= 0.1) continue;
+        std::snprintf(buf, sizeof buf, " %+.2f %s", weakest_direction(i), name(i).c_str());
+        out += buf;
+      }
+    }
+    return out;
+  }
   out += "; not identifiable:";
   for (std::size_t k = 0; k < unobservable.size(); ++k) out += (k ? ", " : " ") + name(unobservable[k]);
   for (int j = 0; j < null_space.cols(); ++j) {

@@ -30,6 +30,7 @@ struct ObservabilityReport {
   Vec singular_values;            // of the scaled, row-normalised O, descending
   Mat null_space;                 // n x (n - rank), scaled coordinates, unit columns
   std::vector<int> unobservable;  // indices with a significant entry in some null direction
+  Vec weakest_direction;          // right singular vector of the smallest singular value
 
   bool full_rank() const { return rank == n; }
   // E.g. "rank 5 of 6; not identifiable: a, b (direction 0.71 a - 0.71 b)".

@@ -370,6 +370,28 @@ sim::Recording convert_real_file(const std::string& spec, const RealConvertSetti
   return rec;
 }
 
+sim::Recording load_any_recording(const std::string& spec) {
+  const std::string text = read_text_or_zip_member(spec);
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (trim(line).empty() || line[0] == '#') continue;
+    const auto names = split(line);
+    const bool project = std::find(names.begin(), names.end(), "t") != names.end() &&
+                         std::find(names.begin(), names.end(), "yaw_rate") != names.end();
+    if (project) {
+      std::istringstream again(text);
+      return sim::RecordingReader::read(again, spec);
+    }
+    break;
+  }
+  sim::Recording rec = convert_real_recording(text, spec);
+  const std::size_t z = spec.find(".zip:");
+  rec.metadata["source"] = z == std::string::npos ? base_name(spec)
+                                                  : base_name(spec.substr(0, z + 4)) + ":" + base_name(spec);
+  return rec;
+}
+
 void write_recording(const sim::Recording& rec, const std::string& path) {
   std::vector<std::string> extras;
   std::vector<const std::vector<double>*> order;

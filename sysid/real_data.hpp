@@ -52,6 +52,10 @@ sim::Recording convert_real_recording(const std::string& text, const std::string
 // Same from a path or "archive.zip:member".
 sim::Recording convert_real_file(const std::string& spec, const RealConvertSettings& settings = {});
 
+// A recording in the project format, or a raw shipped recording converted on the fly
+// (recognised by its header); `spec` as for convert_real_file. Errors name file, line, column.
+sim::Recording load_any_recording(const std::string& spec);
+
 // Writes a Recording (any columns; required ones first as in the reader) to `path` in the
 // project format, metadata lines included. Throws mppi::Error if it cannot be written.
 void write_recording(const sim::Recording& rec, const std::string& path);
