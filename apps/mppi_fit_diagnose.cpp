@@ -32,7 +32,10 @@ const char* kUsage = R"(usage:
     --model NAME        nominal model: single-track (the one supported)     (single-track)
     --params FILE       nominal parameters: single-track YAML or corrected-model file
                         (default: the library defaults = data/config/autorally_single_track.yaml)
+    --log may also be a real recording (DART / ETH CSV, or ARCHIVE.zip:MEMBER.csv), converted
+                        on the fly (sysid/real_data.hpp)
     --holdout H         held-out fraction at the end (0.3) or time range T0:T1 [s]
+    --validate FILE     fit on all of --log, judge on this other recording (replaces --holdout)
     --effects A,B,...   candidate ids (default: all)
     --max-effects N     at most N effects named                              (3)
     --min-improvement F validation-cost reduction an effect must give        (0.05)
@@ -72,7 +75,7 @@ std::vector<std::string> split_list(const std::string& s) {
 }
 
 int cmd_diagnose(int argc, char** argv) {
-  std::string log, params, model = "single-track";
+  std::string log, params, validate, model = "single-track";
   DiagnoseOptions o;
   o.out_dir = "out/diagnose";
   for (int i = 1; i < argc; ++i) {
@@ -85,6 +88,7 @@ int cmd_diagnose(int argc, char** argv) {
     else if (f == "--model") model = value();
     else if (f == "--params") params = value();
     else if (f == "--holdout") o.holdout = value();
+    else if (f == "--validate") validate = value();
     else if (f == "--effects") o.selection.candidates = split_list(value());
     else if (f == "--max-effects") o.selection.max_effects = static_cast<int>(number(f, value()));
     else if (f == "--min-improvement") o.selection.min_val_improvement = number(f, value());
@@ -100,7 +104,12 @@ int cmd_diagnose(int argc, char** argv) {
   for (const auto& id : o.selection.candidates) effect_spec(id);  // throws for unknown ids
   o.model_name = model;
   o.params_source = params;
-  const DiagData d = load_recording(log);
+  DiagData d = load_any(log);
+  if (!validate.empty()) {  // fit on --log, judge on --validate
+    const std::size_t first = d.rows();
+    d = concat(d, load_any(validate));
+    o.holdout = std::to_string(d.t[first] - 1e-6) + ":" + std::to_string(d.t.back() + 1.0);
+  }
   const DiagnoseResult r = run_diagnosis(d, load_nominal(params), o);
   std::printf("mismatch (strongest first):\n");
   for (std::size_t i = 0; i < r.mismatch.size() && i < 8; ++i)

@@ -21,6 +21,7 @@ struct EffectField {
 constexpr EffectField kEffectFields[] = {
     {"steer_offset", &EffectParams::steer_offset},
     {"steer_gain", &EffectParams::steer_gain},
+    {"throttle_offset", &EffectParams::throttle_offset},
     {"steer_delay_s", &EffectParams::steer_delay_s},
     {"throttle_delay_s", &EffectParams::throttle_delay_s},
     {"steer_lag_s", &EffectParams::steer_lag_s},
@@ -29,6 +30,7 @@ constexpr EffectField kEffectFields[] = {
     {"rolling_force_N", &EffectParams::rolling_force_N},
     {"rolling_viscous_Nspm", &EffectParams::rolling_viscous_Nspm},
     {"tyre_peak_scale", &EffectParams::tyre_peak_scale},
+    {"tyre_stiffness_scale", &EffectParams::tyre_stiffness_scale},
     {"grip_scale", &EffectParams::grip_scale},
     {"grip_change_time_s", &EffectParams::grip_change_time_s},
     {"cg_height_delta_m", &EffectParams::cg_height_delta_m},

@@ -8,14 +8,15 @@
 //
 // Effects (ids of the issue):
 //   steer_offset, steer_gain    delta = (gain * s_applied + offset) * max_steer
+//   throttle_offset             throttle u_applied + b (a motor dead band when b < 0)
 //   steer_delay, throttle_delay pure delays, rolled out as a chain of kDelayStages first-order
 //                               stages of delay/kDelayStages each (an Erlang approximation the
 //                               controller can integrate at any step; exact discretisation)
 //   steer_lag, throttle_lag     first-order actuators, time constant tau
 //   aero_drag                   extra force -c vx |vx|
 //   rolling_resistance          extra force -(F0 tanh(vx / 0.5) + b vx)
-//   tire_saturation             Magic Formula peak D -> k D with B -> B / k (same cornering
-//                               stiffness, different friction limit)
+//   tire_saturation             Magic Formula peak D -> k D, B -> s B / k: friction limit x k,
+//                               cornering stiffness (B C D) x s
 //   friction_change             grip (D, Sv) x g from time t_change on (time is a state)
 //   load_transfer               CG height h -> h + dh (pitch load transfer)
 //   motor_voltage_sag           throttle u -> u - k max(u, 0)^2 (battery sag under current)
@@ -34,6 +35,7 @@ namespace mppi {
 struct EffectParams {
   double steer_offset = 0.0;         // steer_offset: added to the applied steer [-]
   double steer_gain = 1.0;           // steer_gain: scale of the applied steer [-]
+  double throttle_offset = 0.0;      // throttle_offset: added to the applied throttle (dead band) [-]
   double steer_delay_s = 0.0;        // steer_delay: pure delay [s]
   double throttle_delay_s = 0.0;     // throttle_delay: pure delay [s]
   double steer_lag_s = 0.0;          // steer_lag: first-order time constant [s]
@@ -41,7 +43,8 @@ struct EffectParams {
   double aero_drag_kgpm = 0.0;       // aero_drag: extra c [N s^2/m^2] in -c vx |vx|
   double rolling_force_N = 0.0;      // rolling_resistance: extra Coulomb force F0 [N]
   double rolling_viscous_Nspm = 0.0; // rolling_resistance: extra viscous b [N s/m]
-  double tyre_peak_scale = 1.0;      // tire_saturation: k in D -> k D, B -> B / k [-]
+  double tyre_peak_scale = 1.0;      // tire_saturation: k in D -> k D, B -> s B / k [-]
+  double tyre_stiffness_scale = 1.0; // tire_saturation: s, cornering stiffness factor [-]
   double grip_scale = 1.0;           // friction_change: grip factor g after the change [-]
   double grip_change_time_s = 0.0;   // friction_change: time of the change [s] (time state)
   double cg_height_delta_m = 0.0;    // load_transfer: dh added to the CG height [m]
@@ -54,15 +57,15 @@ struct EffectParams {
       if (why) *why = m;
       return false;
     };
-    const double all[] = {steer_offset, steer_gain, steer_delay_s, throttle_delay_s, steer_lag_s,
+    const double all[] = {steer_offset, steer_gain, throttle_offset, steer_delay_s, throttle_delay_s, steer_lag_s,
                           throttle_lag_s, aero_drag_kgpm, rolling_force_N, rolling_viscous_Nspm,
-                          tyre_peak_scale, grip_scale, grip_change_time_s, cg_height_delta_m,
+                          tyre_peak_scale, tyre_stiffness_scale, grip_scale, grip_change_time_s, cg_height_delta_m,
                           voltage_sag, grade_x, grade_y};
     for (double v : all)
       if (!std::isfinite(v)) return fail("every effect parameter must be finite");
     if (steer_delay_s < 0 || throttle_delay_s < 0 || steer_lag_s < 0 || throttle_lag_s < 0)
       return fail("delays and lags must be >= 0");
-    if (!(tyre_peak_scale > 0.05 && grip_scale > 0.05)) return fail("tyre_peak_scale and grip_scale must be > 0.05");
+    if (!(tyre_peak_scale > 0.05 && grip_scale > 0.05 && tyre_stiffness_scale > 0.05)) return fail("tyre_peak_scale and grip_scale must be > 0.05");
     if (!(std::abs(grade_x) < 0.5 && std::abs(grade_y) < 0.5)) return fail("|grade| must be < 0.5");
     if (!(voltage_sag >= 0 && voltage_sag < 1)) return fail("voltage_sag must be in [0, 1)");
     return true;
@@ -74,7 +77,7 @@ struct EffectParams {
 inline SingleTrackParams apply_effect_params(SingleTrackParams p, const EffectParams& e, double grip) {
   p.tyre.D *= e.tyre_peak_scale * grip;
   p.tyre.Sv *= grip;
-  p.tyre.B /= e.tyre_peak_scale;
+  p.tyre.B *= e.tyre_stiffness_scale / e.tyre_peak_scale;
   p.cg_height_m += e.cg_height_delta_m;
   return p;
 }
@@ -111,6 +114,7 @@ class CorrectedSingleTrack {
     gain_ = static_cast<float>(effects_.steer_gain);
     offset_ = static_cast<float>(effects_.steer_offset);
     sag_ = static_cast<float>(effects_.voltage_sag);
+    thr_offset_ = static_cast<float>(effects_.throttle_offset);
   }
 
   const SingleTrackParams& nominal() const { return nominal_; }
@@ -153,7 +157,7 @@ class CorrectedSingleTrack {
     const SingleTrackCoeffs<float> kb = before_, ka = after_;
     const float drag = drag_per_kg_, roll = roll_per_kg_, visc = visc_per_kg_;
     const float gx = grade_x_, gy = grade_y_, tc = change_time_, gain = gain_, offset = offset_,
-                sag = sag_;
+                sag = sag_, thr_offset = thr_offset_;
     const float* ps = u[control::kSteer];
     const float* pt = u[control::kThrottle];
     for (int j = 0; j < W; ++j) {
@@ -170,7 +174,7 @@ class CorrectedSingleTrack {
       }
       const float steer = gain * steer_applied + offset;
       const float thr_pos = std::max(thr_applied, 0.f);
-      const float thr = thr_applied - sag * thr_pos * thr_pos;
+      const float thr = thr_applied + thr_offset - sag * thr_pos * thr_pos;
       const float vx = x[state::kVx][j], vy = x[state::kVy][j], r = x[state::kYawRate][j];
       const float yaw = x[state::kYaw][j];
       const float t = x[kTime][j];
@@ -215,7 +219,7 @@ class CorrectedSingleTrack {
   EffectParams effects_;
   SingleTrackCoeffs<float> before_{}, after_{};
   float drag_per_kg_ = 0, roll_per_kg_ = 0, visc_per_kg_ = 0, grade_x_ = 0, grade_y_ = 0;
-  float change_time_ = 0, gain_ = 1, offset_ = 0, sag_ = 0;
+  float change_time_ = 0, gain_ = 1, offset_ = 0, sag_ = 0, thr_offset_ = 0;
 };
 
 // The corrected-model file (YAML; written by mppi-fit diagnose, docs/DIAGNOSE.md):

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "mppi/error.hpp"
+#include "sysid/real_data.hpp"
 
 namespace mppi::diagnose {
 
@@ -68,6 +69,34 @@ DiagData prepare(const sim::Recording& rec, const std::string& source, std::size
 
 DiagData load_recording(const std::string& path) {
   return prepare(sim::RecordingReader::read(path), path);
+}
+
+DiagData concat(const DiagData& a, const DiagData& b) {
+  if (a.control_lead != b.control_lead)
+    throw Error(a.source + " and " + b.source + ": recordings of different kinds (command timing) cannot be combined");
+  DiagData d = a;
+  d.source = a.source + " + " + b.source;
+  const double shift = a.t.back() + 10.0 - b.t.front();
+  int max_piece = -1;
+  for (int p : a.piece) max_piece = std::max(max_piece, p);
+  auto append = [](std::vector<double>& to, const std::vector<double>& from, double add) {
+    for (double v : from) to.push_back(v + add);
+  };
+  append(d.t, b.t, shift);
+  append(d.x, b.x, 0);
+  append(d.y, b.y, 0);
+  append(d.yaw, b.yaw, 0);
+  append(d.vx, b.vx, 0);
+  append(d.vy, b.vy, 0);
+  append(d.r, b.r, 0);
+  append(d.steer, b.steer, 0);
+  append(d.throttle, b.throttle, 0);
+  for (int p : b.piece) d.piece.push_back(p < 0 ? -1 : p + max_piece + 1);
+  return d;
+}
+
+DiagData load_any(const std::string& spec) {
+  return prepare(sysid::load_any_recording(spec), spec);
 }
 
 Split make_split(const DiagData& d, const std::string& holdout) {

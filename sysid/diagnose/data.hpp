@@ -38,6 +38,14 @@ DiagData prepare(const sim::Recording& rec, const std::string& source, std::size
 // Reads and prepares a recording file (sim::RecordingReader, then prepare()).
 DiagData load_recording(const std::string& path);
 
+// Training recording followed by a validation recording (separate pieces, the second's times
+// shifted to follow the first); rows of `b` start at index a.rows().
+DiagData concat(const DiagData& a, const DiagData& b);
+
+// Reads a recording in the project format, or converts a real recording (DART / ETH, plain CSV
+// or "ARCHIVE.zip:MEMBER.csv") through sysid::load_any_recording, then prepare().
+DiagData load_any(const std::string& spec);
+
 // Held-out split: rows [0, split) train, [split, rows) held out. `holdout` is "0.3" (fraction at
 // the end) or "T0:T1" (a time range in s, held out; the training part is everything else, so
 // the split is then expressed as a row mask). Throws mppi::Error for malformed text.
