@@ -277,6 +277,15 @@ int mppi_fit_estimate(int argc, char** argv) {
       y << "\n" << spec.to_yaml(res.final_values);
       if (!y) throw Error(out_dir + "/estimated.yaml: cannot write");
     }
+    // The file must load in the simulator and the controller: parse it back with their loader.
+    try {
+      if (model == "single-track")
+        (void)load_single_track_params(out_dir + "/estimated.yaml");
+      else
+        (void)load_full_vehicle_params(out_dir + "/estimated.yaml");
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "mppi-fit estimate: WARNING: the estimated parameters do not load: %s\n", e.what());
+    }
     {
       std::ofstream c(out_dir + "/convergence.csv");
       c << "t";
@@ -359,7 +368,8 @@ int mppi_fit_estimate(int argc, char** argv) {
     std::ostringstream sum;
     sum << "model " << spec.kind << ", estimator " << (st.adaptive ? "ALM-UKF" : "joint-state UKF") << ", recording "
         << input << "\nfit: " << res.steps << " steps, t " << res.t.front() << ".." << res.t.back() << " s, "
-        << res.wall_s << " s wall, PD projections " << res.projections << "\nmeasured:";
+        << res.wall_s << " s wall, PD projections " << res.projections << ", rejected steps " << res.rejected_steps
+        << "\nmeasured:";
     for (std::size_t i = 0; i < res.measured.size(); ++i)
       sum << " " << res.measured[i] << " (innovation rms " << res.innovation_rms[i] << ")";
     sum << "\n\nparameter                    initial     estimate    2sd         truth       error%   converged(2%) s\n";

@@ -74,6 +74,7 @@ struct EstimateResult {
   std::vector<double> innovation_rms;                    // per measured column, over the fit
   int steps = 0;
   int projections = 0;
+  int rejected_steps = 0;  // steps undone because the state went non-finite
   double wall_s = 0;
 };
 
