@@ -24,7 +24,7 @@ namespace {
 const char* kEstimateUsage = R"(usage: mppi-fit estimate RECORDING [options]
   RECORDING            a recording (docs/RECORDING_FORMAT.md), or a shipped raw one converted on
                        the fly: real/dart_jetracer.zip:<member>.csv (see mppi-fit convert --list)
-  --model NAME         single-track | full-vehicle                         (single-track)
+  --model NAME         single-track | double-track | full-vehicle          (single-track)
   --params FILE        base parameters (YAML of that model; default data/config/autorally_<model>.yaml)
   --estimate A,B,...   parameters to estimate (YAML keys, tyre.B etc.; default: see --list-params)
   --list-params        print the parameter names of the model and exit
@@ -105,8 +105,8 @@ int mppi_fit_estimate(int argc, char** argv) {
         return 0;
       } else if (a == "--model") {
         model = value();
-        if (model != "single-track" && model != "full-vehicle")
-          throw Error("--model expects single-track or full-vehicle, got '" + model + "'");
+        if (model != "single-track" && model != "double-track" && model != "full-vehicle")
+          throw Error("--model expects single-track, double-track or full-vehicle, got '" + model + "'");
       } else if (a == "--params") {
         params_file = value();
       } else if (a == "--estimate") {
@@ -164,7 +164,9 @@ int mppi_fit_estimate(int argc, char** argv) {
       }
     }
     if (list_params) {
-      for (const auto& n : model == "single-track" ? single_track_param_names() : full_vehicle_param_names())
+      for (const auto& n : model == "single-track"   ? single_track_param_names()
+                           : model == "double-track" ? double_track_param_names()
+                                                     : full_vehicle_param_names())
         std::printf("%s\n", n.c_str());
       return 0;
     }
@@ -192,6 +194,14 @@ int mppi_fit_estimate(int argc, char** argv) {
         estimate_names = {"yaw_inertia_kgm2", "cg_to_front_axle_m", "tyre.B", "tyre.C", "tyre.D"};
       spec = single_track_spec(base, estimate_names, keep_wheelbase);
       if (have_truth) truth_spec = single_track_spec(load_single_track_params(truth_file), estimate_names);
+    } else if (model == "double-track") {
+      const DoubleTrackParams base = load_double_track_params(
+          params_file.empty() ? sim::data_file("config/autorally_double_track.yaml") : params_file);
+      if (estimate_names.empty())
+        estimate_names = {"mass_kg", "yaw_inertia_kgm2", "rear_wheel_inertia_kgm2", "cg_height_m",
+                          "cg_to_front_axle_m", "tyre.B", "tyre.C", "tyre.D"};
+      spec = double_track_spec(base, estimate_names, keep_wheelbase);
+      if (have_truth) truth_spec = double_track_spec(load_double_track_params(truth_file), estimate_names);
     } else {
       const FullVehicleParams base = load_full_vehicle_params(
           params_file.empty() ? sim::data_file("config/autorally_full_vehicle.yaml") : params_file);
@@ -281,6 +291,8 @@ int mppi_fit_estimate(int argc, char** argv) {
     try {
       if (model == "single-track")
         (void)load_single_track_params(out_dir + "/estimated.yaml");
+      else if (model == "double-track")
+        (void)load_double_track_params(out_dir + "/estimated.yaml");
       else
         (void)load_full_vehicle_params(out_dir + "/estimated.yaml");
     } catch (const std::exception& e) {

@@ -96,7 +96,12 @@ ObservabilityReport observability(const TransitionFn& f, const MeasurementFn& h,
 }
 
 std::string ObservabilityReport::describe(const std::vector<std::string>& names) const {
-  auto name = [&](int i) { return i < static_cast<int>(names.size()) ? names[i] : "x" + std::to_string(i); };
+  auto name = [&](int i) { 
+    if (i < static_cast<int>(names.size())) return names[i];
+    std::string s = "x";
+    s += std::to_string(i);
+    return s;
+  };
   std::string out = "rank " + std::to_string(rank) + " of " + std::to_string(n);
   if (full_rank()) {
     out += ": every state and parameter is locally identifiable";
@@ -114,9 +119,14 @@ std::string ObservabilityReport::describe(const std::vector<std::string>& names)
     return out;
   }
   out += "; not identifiable:";
-  for (std::size_t k = 0; k < unobservable.size(); ++k) out += (k ? ", " : " ") + name(unobservable[k]);
+  for (std::size_t k = 0; k < unobservable.size(); ++k) {
+    out += k ? ", " : " ";
+    out += name(unobservable[k]);
+  }
   for (int j = 0; j < null_space.cols(); ++j) {
-    out += "\n  null direction " + std::to_string(j + 1) + ":";
+    out += "\n  null direction ";
+    out += std::to_string(j + 1);
+    out += ":";
     for (int i = 0; i < n; ++i) {
       if (std::abs(null_space(i, j)) <= 0.05) continue;
       char buf[64];

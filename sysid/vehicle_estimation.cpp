@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 
+#include "dynamics/double_track.hpp"
 #include "dynamics/full_vehicle.hpp"
 #include "dynamics/single_track.hpp"
 #include "mppi/error.hpp"
@@ -56,6 +57,13 @@ double* full_vehicle_field(FullVehicleParams& p, const std::string& n) {
       {"drag_coefficient", &FullVehicleParams::drag_coefficient}};
   if (auto it = m.find(n); it != m.end()) return &(p.*(it->second));
   if (n == "aero_drag_kgpm") return nullptr;  // the full vehicle's drag is drag_coefficient
+  return single_track_field(p.base, n);
+}
+
+double* double_track_field(DoubleTrackParams& p, const std::string& n) {
+  if (n == "front_track_m") return &p.front_track_m;
+  if (n == "rear_track_m") return &p.rear_track_m;
+  if (n == "front_roll_share") return &p.front_roll_share;
   return single_track_field(p.base, n);
 }
 
@@ -161,6 +169,53 @@ VehicleModelSpec single_track_spec(const SingleTrackParams& base, const std::vec
   };
   s.to_yaml = [with](const std::vector<double>& v) { return to_yaml(with(v)); };
   s.process_std_per_sqrt_s = {0.01, 0.01, 0.005, 0.2, 0.2, 0.2, 1e-6, 5.0, 5.0};
+  return s;
+}
+
+std::vector<std::string> double_track_param_names() {
+  auto v = single_track_param_names();
+  for (const char* n : {"front_track_m", "rear_track_m", "front_roll_share"}) v.push_back(n);
+  return v;
+}
+
+VehicleModelSpec double_track_spec(const DoubleTrackParams& base, const std::vector<std::string>& estimated,
+                                   bool keep_wheelbase) {
+  std::string why;
+  if (!base.is_valid(&why)) throw Error("double-track base parameters: " + why);
+  VehicleModelSpec s;
+  s.kind = "double-track";
+  s.nx = DoubleTrack::kNx;
+  s.state_names = {"x", "y", "yaw", "vx", "vy", "yaw_rate", "roll", "omega_lf", "omega_rf", "omega_lr", "omega_rr"};
+  s.measurable = {{"x", 0}, {"y", 1}, {"yaw", 2}, {"vx", 3}, {"vy", 4}, {"yaw_rate", 5},
+                  {"omega_lf", 7}, {"omega_rf", 8}, {"omega_lr", 9}, {"omega_rr", 10}};
+  prepare(s, base, estimated, double_track_param_names(), double_track_field);
+  const double wheelbase = base.base.wheelbase_m();
+  const std::vector<std::string> names = s.estimated;
+  auto with = [base, names, keep_wheelbase, wheelbase](const std::vector<double>& v) {
+    DoubleTrackParams p = base;
+    for (std::size_t i = 0; i < names.size(); ++i) *double_track_field(p, names[i]) = v[i];
+    if (keep_wheelbase) p.base.cg_to_rear_axle_m = std::max(1e-3, wheelbase - p.base.cg_to_front_axle_m);
+    return p;
+  };
+  s.step = [with](const std::vector<double>& v, double* x, const double* u, double dt) {
+    const FourWheelCoeffs<double> k = double_track_coeffs(with(v));
+    substep(dt, 0.002, [&](double h) {  // explicit Euler, as DoubleTrack::step
+      double dx[DoubleTrack::kNx];
+      DoubleTrack::derivatives(k, x, u, dx);
+      for (int i = 0; i < DoubleTrack::kNx; ++i) x[i] += dx[i] * h;
+    });
+  };
+  const double radius = base.base.wheel_radius_m;
+  s.init_state = [radius](const sim::Recording& rec, std::size_t row, double* x) {
+    const char* cols[11] = {"x", "y", "yaw", "vx", "vy", "yaw_rate", "roll", "omega_lf", "omega_rf",
+                            "omega_lr", "omega_rr"};
+    for (int i = 0; i < 6; ++i) x[i] = value_or(rec, cols[i], row, 0.0);
+    x[6] = 0;
+    const double w = value_or(rec, "wheel_speed", row, x[3]) / radius;
+    for (int i = 7; i <= 10; ++i) x[i] = value_or(rec, cols[i], row, w);
+  };
+  s.to_yaml = [with](const std::vector<double>& v) { return to_yaml(with(v)); };
+  s.process_std_per_sqrt_s = {0.01, 0.01, 0.005, 0.2, 0.2, 0.2, 1e-6, 5, 5, 5, 5};
   return s;
 }
 

@@ -17,7 +17,7 @@ namespace mppi::sysid {
 // state, the parameters that may be estimated (YAML key names, e.g. "mass_kg", "tyre.B",
 // "front_damper_Nspm"), and a double-precision step with chosen parameter values.
 struct VehicleModelSpec {
-  std::string kind;                       // "single-track" | "full-vehicle"
+  std::string kind;                       // "single-track" | "double-track" | "full-vehicle"
   int nx = 0;
   std::vector<std::string> state_names;
   std::vector<std::pair<std::string, int>> measurable;  // recording column -> state index
@@ -38,10 +38,13 @@ struct VehicleModelSpec {
 // The parameter names each model accepts (for --help and error messages).
 std::vector<std::string> single_track_param_names();
 std::vector<std::string> full_vehicle_param_names();
+std::vector<std::string> double_track_param_names();
 
 // Throws mppi::Error naming an unknown parameter and listing the known ones.
 // keep_wheelbase: estimating cg_to_front_axle_m moves the CG (l_r = wheelbase - l_f).
 VehicleModelSpec single_track_spec(const SingleTrackParams& base, const std::vector<std::string>& estimated,
+                                   bool keep_wheelbase = false);
+VehicleModelSpec double_track_spec(const DoubleTrackParams& base, const std::vector<std::string>& estimated,
                                    bool keep_wheelbase = false);
 VehicleModelSpec full_vehicle_spec(const FullVehicleParams& base, const std::vector<std::string>& estimated,
                                    bool keep_wheelbase = false);
