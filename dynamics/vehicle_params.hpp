@@ -73,7 +73,7 @@ struct DoubleTrackParams {
   // Share of the roll moment m a_y h carried by the front axle. Chosen: the suspension's
   // roll-stiffness share K_f w_f^2 / (K_f w_f^2 + K_r w_r^2) with K_f = K_r (the paper fixes
   // K_f = K_r = 2000 N/m), i.e. 0.395^2 / (0.395^2 + 0.405^2).
-  double front_roll_share = 0.48748;
+  double front_roll_share = 0.487502;
   // Scale of the lateral load transfer [-]: 1 = physical, 0 = none (the single-track limit).
   double lateral_load_transfer = 1.0;
 

@@ -287,7 +287,7 @@ TEST_CASE("Double-track parameters: YAML file, round trip, errors", "[physics][d
   CHECK(file.base.tyre.E == def.base.tyre.E);
   CHECK(file.base.aero_drag_kgpm == def.base.aero_drag_kgpm);
   // front_roll_share is the roll-stiffness share for K_f = K_r.
-  CHECK(def.front_roll_share == Approx(0.395 * 0.395 / (0.395 * 0.395 + 0.405 * 0.405)).epsilon(1e-4));
+  CHECK(def.front_roll_share == Approx(0.395 * 0.395 / (0.395 * 0.395 + 0.405 * 0.405)).epsilon(1e-6));
 
   DoubleTrackParams changed;
   changed.front_track_m = 0.5;
