@@ -186,7 +186,7 @@ int cmd_sweep(int argc, char** argv) {
     const std::string name = (id.empty() ? "none" : id) + "_" + size + "_s" + std::to_string(seed);
     so.work_dir = out + "/work/" + name;
     const std::string csv = out + "/" + name + ".csv";
-    synthesize(so, csv);
+    if (!std::filesystem::exists(csv)) synthesize(so, csv);  // a rerun reuses the recordings
     DiagnoseOptions o;
     o.plots = false;
     const DiagnoseResult r = run_diagnosis(load_recording(csv), SingleTrackParams{}, o);

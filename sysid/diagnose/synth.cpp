@@ -55,6 +55,7 @@ const std::vector<SweepCase>& sweep_cases() {
       {"throttle_lag", "throttle_lag_s=0.1", "throttle_lag_s=0.3"},
       {"steer_offset", "steer_offset=0.03", "steer_offset=0.1"},
       {"steer_gain", "steer_gain=0.85", "steer_gain=0.65"},
+      {"throttle_offset", "throttle_offset=-0.05", "throttle_offset=-0.15"},
       {"tire_saturation", "tyre_peak_scale=0.8", "tyre_peak_scale=0.6"},
       {"friction_change", "grip_change_time_s=15,grip_scale=0.8", "grip_change_time_s=15,grip_scale=0.6"},
       {"load_transfer", "cg_height_delta_m=0.05", "cg_height_delta_m=0.1"},
