@@ -33,7 +33,7 @@ double residuals(const FitProblem& p, const EffectParams& e, std::vector<double>
   return r->empty() ? 0.0 : s / static_cast<double>(r->size());
 }
 
-double one_step_normalized_rmse(const CorrectedSingleTrack& m, const DiagData& d, const std::vector<char>& mask,
+double heldout_1s_normalized_rmse(const CorrectedSingleTrack& m, const DiagData& d, const std::vector<char>& mask,
                                 const ReplayOptions& o) {
   return horizon_metrics(m, d, mask, {1.0}, 5, o)[0].normalized_rmse;
 }
@@ -193,7 +193,7 @@ Selection select_effects(const DiagData& d, const SingleTrackParams& nominal,
   else
     for (const auto& id : opt.candidates) cands.push_back(&effect_spec(id));
 
-  const double held_nominal = one_step_normalized_rmse(CorrectedSingleTrack(nominal), d, heldout_mask, replay);
+  const double held_nominal = heldout_1s_normalized_rmse(CorrectedSingleTrack(nominal), d, heldout_mask, replay);
   EffectParams base;
   double base_fit = mean_cost(fit, base), base_val = mean_cost(val, base);
   char line[512];
@@ -221,7 +221,7 @@ Selection select_effects(const DiagData& d, const SingleTrackParams& nominal,
         c.bic_delta = bic;
         CorrectedSingleTrack m;
         c.heldout_improvement =
-            make_model(all, r.effects, &m) ? 1.0 - one_step_normalized_rmse(m, d, heldout_mask, replay) / held_nominal : 0.0;
+            make_model(all, r.effects, &m) ? 1.0 - heldout_1s_normalized_rmse(m, d, heldout_mask, replay) / held_nominal : 0.0;
       }
       std::snprintf(line, sizeof line, "round %d: %-18s validation %+6.1f %%, dBIC %+9.1f", round,
                     cands[i]->id.c_str(), 100 * impr, bic);

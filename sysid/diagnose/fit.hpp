@@ -39,7 +39,6 @@ struct FitResult {
 };
 
 // Fits the free parameters `free` starting from `base` (whose other fields stay fixed).
-// `time_free` lists parameters searched on a grid instead (with the grid given).
 FitResult fit_params(const FitProblem& p, const EffectParams& base, const std::vector<ParamSpec>& free,
                      int max_iterations = 15);
 
