@@ -383,7 +383,8 @@ int mppi_fit_estimate(int argc, char** argv) {
         << res.wall_s << " s wall, PD projections " << res.projections << ", rejected steps " << res.rejected_steps
         << "\nmeasured:";
     for (std::size_t i = 0; i < res.measured.size(); ++i)
-      sum << " " << res.measured[i] << " (innovation rms " << res.innovation_rms[i] << ")";
+      sum << " " << res.measured[i] << " (innovation rms " << res.innovation_rms[i] << ", noise std "
+          << res.measurement_std[i] << ")";
     sum << "\n\nparameter                    initial     estimate    2sd         truth       error%   converged(2%) s\n";
     std::ofstream pc(out_dir + "/parameters.csv");
     pc << "name,initial,estimate,std,truth,error_pct,converged_2pct_s,converged_5pct_s\n";

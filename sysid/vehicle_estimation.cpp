@@ -421,6 +421,7 @@ EstimateResult estimate_parameters(const VehicleModelSpec& spec, const sim::Reco
   res.final_values = res.history.back();
   res.final_std = res.history_std.back();
   for (int i = 0; i < ny; ++i) res.innovation_rms.push_back(innov_n[i] ? std::sqrt(innov_sq[i] / innov_n[i]) : kNaN);
+  for (int i = 0; i < ny; ++i) res.measurement_std.push_back(std::sqrt(std::max(0.0, filt.ukf().R()(i, i))));
   res.projections = filt.projections();
   res.rejected_steps = filt.rejected_steps();
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_wall).count();

@@ -75,6 +75,7 @@ struct EstimateResult {
   std::vector<std::vector<double>> history_std;
   std::vector<std::string> measured;                     // columns used
   std::vector<double> innovation_rms;                    // per measured column, over the fit
+  std::vector<double> measurement_std;                   // final sqrt(diag R) (ALM: estimated)
   int steps = 0;
   int projections = 0;
   int rejected_steps = 0;  // steps undone because the state went non-finite
