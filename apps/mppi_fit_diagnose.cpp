@@ -39,12 +39,14 @@ const char* kUsage = R"(usage:
     --effects A,B,...   candidate ids (default: all)
     --max-effects N     at most N effects named                              (3)
     --min-improvement F validation-cost reduction an effect must give        (0.05)
+    --min-bic-drop B    and BIC decrease                                     (10)
     --out DIR           report.json, report.md, PNG plots, corrected_model.yaml (out/diagnose)
     --no-plots          skip the PNG plots
   mppi-fit diagnose synth --out FILE.csv [--effect key=value,...] [--seed N] [--duration S]
                           [--speed V] [--samples K] [--track NAME] [--noise-scale F]
   mppi-fit diagnose sweep [--seeds N] [--sizes small,large] [--effects A,B,...] [--clean N]
-                          [--duration S] [--out DIR]
+                          [--duration S] [--min-bic-drop B] [--out DIR]
+                          (recordings already in DIR are reused)
   mppi-fit diagnose loop --truth key=value,... --model-params FILE [--laps N] [--speed V]
                          [--samples K] [--seed N] [--out DIR]
 Effect ids: aero_drag rolling_resistance steer_delay throttle_delay steer_lag throttle_lag
@@ -92,6 +94,7 @@ int cmd_diagnose(int argc, char** argv) {
     else if (f == "--effects") o.selection.candidates = split_list(value());
     else if (f == "--max-effects") o.selection.max_effects = static_cast<int>(number(f, value()));
     else if (f == "--min-improvement") o.selection.min_val_improvement = number(f, value());
+    else if (f == "--min-bic-drop") o.selection.min_bic_drop = number(f, value());
     else if (f == "--out") o.out_dir = value();
     else if (f == "--no-plots") o.plots = false;
     else if (f == "--help" || f == "-h") {
@@ -153,6 +156,7 @@ int cmd_synth(int argc, char** argv) {
 
 int cmd_sweep(int argc, char** argv) {
   int seeds = 2, clean = 4;
+  SelectionOptions sel;
   double duration = 60;
   std::vector<std::string> sizes = {"small", "large"}, effects;
   std::string out = "out/diagnose_sweep";
@@ -168,6 +172,7 @@ int cmd_sweep(int argc, char** argv) {
     else if (f == "--effects") effects = split_list(value());
     else if (f == "--duration") duration = number(f, value());
     else if (f == "--out") out = value();
+    else if (f == "--min-bic-drop") sel.min_bic_drop = number(f, value());
     else throw UsageError("unknown option " + f);
   }
   std::filesystem::create_directories(out);
@@ -189,6 +194,7 @@ int cmd_sweep(int argc, char** argv) {
     if (!std::filesystem::exists(csv)) synthesize(so, csv);  // a rerun reuses the recordings
     DiagnoseOptions o;
     o.plots = false;
+    o.selection = sel;
     const DiagnoseResult r = run_diagnosis(load_recording(csv), SingleTrackParams{}, o);
     Row row{id.empty() ? "none" : id, size, "", seed, false, false, r.heldout_rmse_reduction};
     for (const auto& s : r.selection.selected) {
