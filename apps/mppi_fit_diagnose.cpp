@@ -39,7 +39,7 @@ const char* kUsage = R"(usage:
     --effects A,B,...   candidate ids (default: all)
     --max-effects N     at most N effects named                              (3)
     --min-improvement F validation-cost reduction an effect must give        (0.05)
-    --min-bic-drop B    and BIC decrease                                     (10)
+    --min-bic-drop B    and BIC decrease                                     (2)
     --out DIR           report.json, report.md, PNG plots, corrected_model.yaml (out/diagnose)
     --no-plots          skip the PNG plots
   mppi-fit diagnose synth --out FILE.csv [--effect key=value,...] [--seed N] [--duration S]

@@ -48,7 +48,7 @@ FitResult fit_effect(const FitProblem& p, const EffectParams& base, const Effect
 struct SelectionOptions {
   double fit_horizon_s = 0.5;       // multi-step horizon of the fit residuals [s]
   double min_val_improvement = 0.05;  // relative validation-cost reduction an effect must give
-  double min_bic_drop = 10.0;       // and BIC decrease (effective sample count)
+  double min_bic_drop = 2.0;        // and BIC decrease (effective sample count; 2 = "positive evidence")
   double samples_per_independent = 5.0;  // residual correlation: samples per independent one
   int max_effects = 3;
   std::vector<std::string> candidates;  // empty = the whole library
