@@ -13,8 +13,12 @@ namespace {
 const char* kUsage = R"(usage: mppi-sim [options]
   --track NAME         gazebo | marietta | ccrf                      (default gazebo)
   --clockwise          drive clockwise (default counter-clockwise)
-  --model NAME         controller model: autorally-nn | single-track | kinematic (autorally-nn)
-  --plant NAME         simulated car: single-track | autorally-nn | kinematic (single-track)
+  --model NAME         controller model: autorally-nn | single-track | kinematic | corrected
+                       (autorally-nn; corrected = nominal + effects from mppi-fit diagnose)
+                       | double-track | full-vehicle (four-wheel physics models)
+  --plant NAME         simulated car: single-track | autorally-nn | kinematic | corrected
+                       (single-track)
+                       | double-track | full-vehicle (four-wheel physics models)
   --speed MPS          target speed [m/s]                            (6)
   --laps N             laps to drive                                 (5)
   --max-time S         stop after S simulated seconds (default: from the laps)
@@ -29,8 +33,9 @@ const char* kUsage = R"(usage: mppi-sim [options]
                        there is one, else the CPU; vulkan also takes a CPU Vulkan
                        device (lavapipe); MPPI_VULKAN_DEVICE=<index|name> picks one (auto)
   --cost-config FILE   AutoRally cost weights (YAML)
-  --plant-params FILE  single-track plant parameters (YAML)
-  --model-params FILE  physics controller-model parameters (YAML)
+  --plant-params FILE  single-track plant parameters (YAML; corrected-model file for corrected)
+                       (double-track / full-vehicle: their YAML, data/config/autorally_*.yaml)
+  --model-params FILE  physics controller-model parameters (YAML; corrected-model file for corrected)
   --network FILE       AutoRally network (.npz)
   --out DIR            write DIR/log.csv, DIR/track.png, DIR/summary.json (default out/sim)
   --json               print summary.json to stdout

@@ -20,3 +20,12 @@ write_basic_package_version_file(${PROJECT_BINARY_DIR}/mppiConfigVersion.cmake
   VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/mppiConfig.cmake ${PROJECT_BINARY_DIR}/mppiConfigVersion.cmake
         DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/mppi)
+
+# The estimation part (sysid/), when built: its headers and library join the package.
+if(TARGET mppi_sysid)
+  install(DIRECTORY ${PROJECT_SOURCE_DIR}/sysid/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/sysid
+          FILES_MATCHING PATTERN "*.hpp")
+  install(TARGETS mppi_sysid EXPORT mppiTargets
+          ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+          LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+endif()

@@ -4,7 +4,9 @@
 // paper's robot-parameter, bifilar-pendulum and tyre tables; the rest (steering range,
 // drivetrain, resistances, regularisation) the paper does not give: they are chosen to be
 // plausible for a 22 kg 1:5 rally car and are meant to be calibrated.
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include "dynamics/pacejka.hpp"
 
@@ -62,6 +64,63 @@ struct KinematicBicycleParams {
   bool is_valid(std::string* why) const;
 };
 
+// The double-track (four-wheel) model: the single-track's parameters plus track widths and
+// the quasi-static lateral load transfer (dynamics/double_track.hpp).
+struct DoubleTrackParams {
+  SingleTrackParams base;                  // mass, inertias, l_f, l_r, h, tyres, drivetrain, ...
+  double front_track_m = 0.395;            // w_f [m] (paper: front track)
+  double rear_track_m = 0.405;             // w_r [m] (paper: rear track)
+  // Share of the roll moment m a_y h carried by the front axle. Chosen: the suspension's
+  // roll-stiffness share K_f w_f^2 / (K_f w_f^2 + K_r w_r^2) with K_f = K_r (the paper fixes
+  // K_f = K_r = 2000 N/m), i.e. 0.395^2 / (0.395^2 + 0.405^2).
+  double front_roll_share = 0.487502;
+  // Scale of the lateral load transfer [-]: 1 = physical, 0 = none (the single-track limit).
+  double lateral_load_transfer = 1.0;
+
+  bool is_valid(std::string* why) const;
+};
+
+// The full vehicle (dynamics/full_vehicle.hpp): the double-track's planar motion with
+// per-wheel loads from a sprung mass in heave, roll and pitch on four spring-damper corners,
+// and aerodynamic drag 0.5 C_D rho A V_x |V_x|. base.aero_drag_kgpm must be 0 (the drag is
+// given by drag_coefficient, air_density_kgpm3, frontal_area_m2).
+struct FullVehicleParams {
+  FullVehicleParams() { base.aero_drag_kgpm = 0.0; }
+  SingleTrackParams base;                  // mass, I_z, l_f, l_r, h, tyres, drivetrain, ...
+  // --- measured (paper, robot-parameter table) ---
+  double front_track_m = 0.395;            // w_f [m]
+  double rear_track_m = 0.405;             // w_r [m]
+  double front_wheel_mass_kg = 0.82;       // unsprung mass per front wheel [kg]
+  double rear_wheel_mass_kg = 0.89;        // unsprung mass per rear wheel [kg]
+  // --- the paper's ALM-UKF setting: K_f = K_r = 2000 N/m (fixed for observability) ---
+  double front_spring_Npm = 2000.0;        // K_f per wheel [N/m]
+  double rear_spring_Npm = 2000.0;         // K_r per wheel [N/m]
+  // --- chosen (the paper estimates but does not print them) ---
+  double front_damper_Nspm = 115.0;        // C_f per wheel [N s/m]: heave damping ratio ~0.6
+  double rear_damper_Nspm = 115.0;         // C_r per wheel [N s/m]
+  double sprung_cg_height_m = 0.12;        // h^s [m] above the pitch centre (ground); = h
+  double roll_centre_height_m = 0.05;      // h^c [m] roll-centre height
+  // Sprung-mass inertias about the roll axis and the pitch centre: the bifilar I_x = 0.347 and
+  // I_y = 1.131 (about the CG) moved by the parallel-axis theorem with m^s = 18.46 kg:
+  // I_x + m^s (h^s - h^c)^2 = 0.437, I_y + m^s (h^s)^2 = 1.397.
+  double roll_inertia_kgm2 = 0.437;        // I^R_x [kg m^2]
+  double pitch_inertia_kgm2 = 1.397;       // I^P_y [kg m^2]
+  double drag_coefficient = 0.57;          // C_D [-]
+  double air_density_kgpm3 = 1.2;          // rho_air [kg/m^3]
+  double frontal_area_m2 = 0.147;          // A [m^2] = overall width 0.46 x height 0.32 (paper)
+
+  double sprung_mass_kg() const { return base.mass_kg - 2 * (front_wheel_mass_kg + rear_wheel_mass_kg); }
+  // Roll stiffness share of the front axle, K_f w_f^2 / (K_f w_f^2 + K_r w_r^2).
+  double front_roll_share() const {
+    const double f = front_spring_Npm * front_track_m * front_track_m;
+    return f / (f + rear_spring_Npm * rear_track_m * rear_track_m);
+  }
+  // The double-track that this model tends to as the suspension stiffens (same planar
+  // parameters, the suspension's roll-stiffness share, drag as base.aero_drag_kgpm).
+  DoubleTrackParams rigid_limit() const;
+  bool is_valid(std::string* why) const;
+};
+
 // YAML loaders. Keys not given keep their defaults; an unknown key, a value that is not a
 // number, or parameters that fail is_valid() throw mppi::Error naming the file, key and line.
 // The single-track file has the fields above as top-level keys and a `tyre:` map with
@@ -72,6 +131,26 @@ KinematicBicycleParams load_kinematic_bicycle_params(const std::string& path);
 SingleTrackParams single_track_params_from_yaml(const std::string& text, const std::string& source);
 KinematicBicycleParams kinematic_bicycle_params_from_yaml(const std::string& text,
                                                           const std::string& source);
+// Double-track / full-vehicle files: the single-track keys (full vehicle: without
+// aero_drag_kgpm) plus the fields of DoubleTrackParams / FullVehicleParams as top-level keys
+// (data/config/autorally_double_track.yaml, autorally_full_vehicle.yaml).
+DoubleTrackParams load_double_track_params(const std::string& path);
+FullVehicleParams load_full_vehicle_params(const std::string& path);
+DoubleTrackParams double_track_params_from_yaml(const std::string& text, const std::string& source);
+FullVehicleParams full_vehicle_params_from_yaml(const std::string& text, const std::string& source);
+// Every numeric field by its YAML key (tyre fields as "tyre.B", ...), pointing into `p`: for
+// estimators that treat a chosen set of parameters as a vector. Order as in the YAML files.
+struct NamedParam {
+  std::string key;
+  double* value;
+};
+std::vector<NamedParam> named_parameters(SingleTrackParams& p);
+std::vector<NamedParam> named_parameters(DoubleTrackParams& p);
+std::vector<NamedParam> named_parameters(FullVehicleParams& p);
+// A YAML document of every field (same keys as the loaders), e.g. for estimated parameters.
+std::string to_yaml(const SingleTrackParams& p);
+std::string to_yaml(const DoubleTrackParams& p);
+std::string to_yaml(const FullVehicleParams& p);
 
 // ---------------------------------------------------------------------------------------------
 
@@ -107,6 +186,72 @@ inline bool SingleTrackParams::is_valid(std::string* why) const {
   const double mu_bound = std::abs(tyre.D) + std::abs(tyre.Sv);
   if (!(2 * cg_height_m * mu_bound < wheelbase_m()))
     return fail("cg_height_m too large for the wheelbase and tyre grip (need 2 h (|D|+|Sv|) < l_f + l_r)");
+  return true;
+}
+
+inline bool DoubleTrackParams::is_valid(std::string* why) const {
+  auto fail = [&](const std::string& msg) {
+    if (why) *why = msg;
+    return false;
+  };
+  if (!base.is_valid(why)) return false;
+  if (!(std::isfinite(front_track_m) && front_track_m > 0)) return fail("front_track_m must be > 0");
+  if (!(std::isfinite(rear_track_m) && rear_track_m > 0)) return fail("rear_track_m must be > 0");
+  if (!(front_roll_share >= 0 && front_roll_share <= 1)) return fail("front_roll_share must be in [0, 1]");
+  if (!(lateral_load_transfer >= 0 && lateral_load_transfer <= 1))
+    return fail("lateral_load_transfer must be in [0, 1]");
+  return true;
+}
+
+inline DoubleTrackParams FullVehicleParams::rigid_limit() const {
+  DoubleTrackParams d;
+  d.base = base;
+  d.base.aero_drag_kgpm = 0.5 * drag_coefficient * air_density_kgpm3 * frontal_area_m2;
+  d.front_track_m = front_track_m;
+  d.rear_track_m = rear_track_m;
+  d.front_roll_share = front_roll_share();
+  d.lateral_load_transfer = 1.0;
+  return d;
+}
+
+inline bool FullVehicleParams::is_valid(std::string* why) const {
+  auto fail = [&](const std::string& msg) {
+    if (why) *why = msg;
+    return false;
+  };
+  auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  auto non_negative = [](double v) { return std::isfinite(v) && v >= 0; };
+  if (!base.is_valid(why)) return false;
+  if (base.aero_drag_kgpm != 0)
+    return fail("aero_drag_kgpm must be 0 for the full vehicle (drag is drag_coefficient, "
+                "air_density_kgpm3, frontal_area_m2)");
+  if (!positive(front_track_m)) return fail("front_track_m must be > 0");
+  if (!positive(rear_track_m)) return fail("rear_track_m must be > 0");
+  if (!non_negative(front_wheel_mass_kg)) return fail("front_wheel_mass_kg must be >= 0");
+  if (!non_negative(rear_wheel_mass_kg)) return fail("rear_wheel_mass_kg must be >= 0");
+  if (!(sprung_mass_kg() > 0)) return fail("the wheel masses must leave a sprung mass > 0");
+  if (!positive(front_spring_Npm)) return fail("front_spring_Npm must be > 0");
+  if (!positive(rear_spring_Npm)) return fail("rear_spring_Npm must be > 0");
+  if (!non_negative(front_damper_Nspm)) return fail("front_damper_Nspm must be >= 0");
+  if (!non_negative(rear_damper_Nspm)) return fail("rear_damper_Nspm must be >= 0");
+  if (!non_negative(sprung_cg_height_m)) return fail("sprung_cg_height_m must be >= 0");
+  if (!(std::isfinite(roll_centre_height_m) && roll_centre_height_m <= sprung_cg_height_m))
+    return fail("roll_centre_height_m must be <= sprung_cg_height_m");
+  if (!positive(roll_inertia_kgm2)) return fail("roll_inertia_kgm2 must be > 0");
+  if (!positive(pitch_inertia_kgm2)) return fail("pitch_inertia_kgm2 must be > 0");
+  if (!non_negative(drag_coefficient)) return fail("drag_coefficient must be >= 0");
+  if (!non_negative(air_density_kgpm3)) return fail("air_density_kgpm3 must be >= 0");
+  if (!non_negative(frontal_area_m2)) return fail("frontal_area_m2 must be >= 0");
+  // Gravity must not beat the springs (the sprung mass would tip over at rest).
+  const double ms = sprung_mass_kg(), g = base.gravity_mps2;
+  const double roll_k = 0.5 * (front_spring_Npm * front_track_m * front_track_m +
+                               rear_spring_Npm * rear_track_m * rear_track_m);
+  const double lf = base.cg_to_front_axle_m, lr = base.cg_to_rear_axle_m;
+  const double pitch_k = 2 * (front_spring_Npm * lf * lf + rear_spring_Npm * lr * lr);
+  if (!(roll_k > ms * g * (sprung_cg_height_m - roll_centre_height_m)))
+    return fail("roll stiffness (K_f w_f^2 + K_r w_r^2) / 2 must exceed m^s g (h^s - h^c)");
+  if (!(pitch_k > ms * g * sprung_cg_height_m))
+    return fail("pitch stiffness 2 (K_f l_f^2 + K_r l_r^2) must exceed m^s g h^s");
   return true;
 }
 

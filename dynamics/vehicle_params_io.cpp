@@ -1,5 +1,6 @@
 // YAML -> SingleTrackParams / KinematicBicycleParams, strict: every mistake is an mppi::Error
 // naming the file, line and key.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -79,11 +80,11 @@ std::string read_file(const std::string& path, const std::string& what) {
 
 }  // namespace
 
-SingleTrackParams single_track_params_from_yaml(const std::string& text, const std::string& source) {
-  SingleTrackParams p;
-  const YAML::Node root = parse(text, source);
-  if (!root.IsDefined() || root.IsNull()) return p;  // empty document: all defaults
-  const std::vector<Field> fields = {
+namespace {
+
+// The single-track keys, shared by the double-track and full-vehicle files.
+std::vector<Field> single_track_fields(SingleTrackParams& p, bool with_aero_drag = true) {
+  std::vector<Field> fields = {
       {"mass_kg", &p.mass_kg},
       {"yaw_inertia_kgm2", &p.yaw_inertia_kgm2},
       {"cg_to_front_axle_m", &p.cg_to_front_axle_m},
@@ -102,12 +103,126 @@ SingleTrackParams single_track_params_from_yaml(const std::string& text, const s
       {"slip_speed_floor_mps", &p.slip_speed_floor_mps},
       {"slip_blend", &p.slip_blend},
   };
-  const std::vector<Field> tyre = {{"B", &p.tyre.B}, {"C", &p.tyre.C},   {"D", &p.tyre.D},
-                                   {"E", &p.tyre.E}, {"Sh", &p.tyre.Sh}, {"Sv", &p.tyre.Sv}};
+  if (!with_aero_drag)
+    fields.erase(std::remove_if(fields.begin(), fields.end(),
+                                [](const Field& f) { return std::string(f.key) == "aero_drag_kgpm"; }),
+                 fields.end());
+  return fields;
+}
+
+std::vector<Field> tyre_fields(PacejkaParams& t) {
+  return {{"B", &t.B}, {"C", &t.C}, {"D", &t.D}, {"E", &t.E}, {"Sh", &t.Sh}, {"Sv", &t.Sv}};
+}
+
+std::vector<Field> double_track_fields(DoubleTrackParams& p) {
+  std::vector<Field> f = single_track_fields(p.base);
+  f.insert(f.end(), {{"front_track_m", &p.front_track_m},
+                     {"rear_track_m", &p.rear_track_m},
+                     {"front_roll_share", &p.front_roll_share},
+                     {"lateral_load_transfer", &p.lateral_load_transfer}});
+  return f;
+}
+
+std::vector<Field> full_vehicle_fields(FullVehicleParams& p) {
+  std::vector<Field> f = single_track_fields(p.base, false);
+  f.insert(f.end(), {{"front_track_m", &p.front_track_m},
+                     {"rear_track_m", &p.rear_track_m},
+                     {"front_wheel_mass_kg", &p.front_wheel_mass_kg},
+                     {"rear_wheel_mass_kg", &p.rear_wheel_mass_kg},
+                     {"front_spring_Npm", &p.front_spring_Npm},
+                     {"rear_spring_Npm", &p.rear_spring_Npm},
+                     {"front_damper_Nspm", &p.front_damper_Nspm},
+                     {"rear_damper_Nspm", &p.rear_damper_Nspm},
+                     {"sprung_cg_height_m", &p.sprung_cg_height_m},
+                     {"roll_centre_height_m", &p.roll_centre_height_m},
+                     {"roll_inertia_kgm2", &p.roll_inertia_kgm2},
+                     {"pitch_inertia_kgm2", &p.pitch_inertia_kgm2},
+                     {"drag_coefficient", &p.drag_coefficient},
+                     {"air_density_kgpm3", &p.air_density_kgpm3},
+                     {"frontal_area_m2", &p.frontal_area_m2}});
+  return f;
+}
+
+// Reads `fields` (+ tyre:) from a document into the struct they point into, then validates.
+template <class P>
+P params_from_yaml(P p, std::vector<Field> (*fields_of)(P&), const std::string& text,
+                   const std::string& source, const std::string& what) {
+  const YAML::Node root = parse(text, source);
+  if (root.IsDefined() && !root.IsNull()) {
+    const std::vector<Field> fields = fields_of(p);
+    const std::vector<Field> tyre = tyre_fields(p.base.tyre);
+    read_map(root, fields, source, what + " parameters", "tyre", &tyre);
+  }
+  std::string why;
+  if (!p.is_valid(&why)) throw Error(source + ": invalid " + what + " parameters: " + why);
+  return p;
+}
+
+std::string fields_to_yaml(const std::vector<Field>& fields, const std::vector<Field>& tyre) {
+  std::ostringstream out;
+  out.precision(17);
+  for (const auto& f : fields) out << f.key << ": " << *f.value << "\n";
+  out << "tyre:\n";
+  for (const auto& f : tyre) out << "  " << f.key << ": " << *f.value << "\n";
+  return out.str();
+}
+
+}  // namespace
+
+SingleTrackParams single_track_params_from_yaml(const std::string& text, const std::string& source) {
+  SingleTrackParams p;
+  const YAML::Node root = parse(text, source);
+  if (!root.IsDefined() || root.IsNull()) return p;  // empty document: all defaults
+  const std::vector<Field> fields = single_track_fields(p);
+  const std::vector<Field> tyre = tyre_fields(p.tyre);
   read_map(root, fields, source, "single-track parameters", "tyre", &tyre);
   std::string why;
   if (!p.is_valid(&why)) throw Error(source + ": invalid single-track parameters: " + why);
   return p;
+}
+
+DoubleTrackParams double_track_params_from_yaml(const std::string& text, const std::string& source) {
+  return params_from_yaml(DoubleTrackParams{}, &double_track_fields, text, source, "double-track");
+}
+
+FullVehicleParams full_vehicle_params_from_yaml(const std::string& text, const std::string& source) {
+  return params_from_yaml(FullVehicleParams{}, &full_vehicle_fields, text, source, "full-vehicle");
+}
+
+DoubleTrackParams load_double_track_params(const std::string& path) {
+  return double_track_params_from_yaml(read_file(path, "double-track parameter"), path);
+}
+
+FullVehicleParams load_full_vehicle_params(const std::string& path) {
+  return full_vehicle_params_from_yaml(read_file(path, "full-vehicle parameter"), path);
+}
+
+namespace {
+std::vector<NamedParam> named(const std::vector<Field>& fields, PacejkaParams& tyre) {
+  std::vector<NamedParam> out;
+  for (const auto& f : fields) out.push_back({f.key, f.value});
+  for (const auto& f : tyre_fields(tyre)) out.push_back({std::string("tyre.") + f.key, f.value});
+  return out;
+}
+}  // namespace
+
+std::vector<NamedParam> named_parameters(SingleTrackParams& p) { return named(single_track_fields(p), p.tyre); }
+std::vector<NamedParam> named_parameters(DoubleTrackParams& p) { return named(double_track_fields(p), p.base.tyre); }
+std::vector<NamedParam> named_parameters(FullVehicleParams& p) { return named(full_vehicle_fields(p), p.base.tyre); }
+
+std::string to_yaml(const SingleTrackParams& p) {
+  SingleTrackParams c = p;
+  return fields_to_yaml(single_track_fields(c), tyre_fields(c.tyre));
+}
+
+std::string to_yaml(const DoubleTrackParams& p) {
+  DoubleTrackParams c = p;
+  return fields_to_yaml(double_track_fields(c), tyre_fields(c.base.tyre));
+}
+
+std::string to_yaml(const FullVehicleParams& p) {
+  FullVehicleParams c = p;
+  return fields_to_yaml(full_vehicle_fields(c), tyre_fields(c.base.tyre));
 }
 
 KinematicBicycleParams kinematic_bicycle_params_from_yaml(const std::string& text,

@@ -13,6 +13,9 @@
 #include "costs/cost_config.hpp"
 #include "costs/cost_map.hpp"
 #include "dynamics/autorally_nn.hpp"
+#include "dynamics/double_track.hpp"
+#include "dynamics/full_vehicle.hpp"
+#include "dynamics/corrected_single_track.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
 #include "dynamics/single_track.hpp"
 #include "dynamics/vehicle_params.hpp"
@@ -34,6 +37,30 @@ namespace {
 constexpr const char* kDefaultNetwork = "autorally/models/autorally_nnet_09_12_2018.npz";
 constexpr const char* kDefaultCostYaml = "config/autorally_cost.yaml";
 constexpr const char* kDefaultSingleTrackYaml = "config/autorally_single_track.yaml";
+constexpr const char* kDefaultDoubleTrackYaml = "config/autorally_double_track.yaml";
+constexpr const char* kDefaultFullVehicleYaml = "config/autorally_full_vehicle.yaml";
+
+DoubleTrackParams double_track_params(const std::string& yaml) {
+  return load_double_track_params(yaml.empty() ? data_file(kDefaultDoubleTrackYaml) : yaml);
+}
+FullVehicleParams full_vehicle_params(const std::string& yaml) {
+  return load_full_vehicle_params(yaml.empty() ? data_file(kDefaultFullVehicleYaml) : yaml);
+}
+
+// Controller-model state from another plant: the common states, wheels rolling at vx / R,
+// the rest (suspension) at rest. The same model's plant state is copied whole.
+template <class M>
+std::function<void(const float*, int, float*)> observe_four_wheel(float radius) {
+  return [radius](const float* px, int plant_states, float* mx) {
+    if (plant_states == M::kNx) {
+      std::copy(px, px + M::kNx, mx);
+      return;
+    }
+    std::fill(mx, mx + M::kNx, 0.f);
+    std::copy(px, px + state::kCommonStates, mx);
+    for (int i = 0; i < 4; ++i) mx[M::kOmega + i] = px[state::kVx] / radius;
+  };
+}
 
 SingleTrackParams single_track_params(const std::string& yaml) {
   return load_single_track_params(yaml.empty() ? data_file(kDefaultSingleTrackYaml) : yaml);
@@ -107,9 +134,40 @@ ControllerSetup make_controller(const ClosedLoopConfig& config, const AutoRallyC
       mx[state::kY] -= l_r * std::sin(px[state::kYaw]);
       mx[state::kVy] = 0.f;
     };
+  } else if (config.model == "double-track" || config.model == "full-vehicle") {
+    const bool full = config.model == "full-vehicle";
+    if (full) {
+      const FullVehicle model(full_vehicle_params(config.model_params_yaml));
+      setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
+      setup.model_states = FullVehicle::kNx;
+      setup.observe = observe_four_wheel<FullVehicle>(static_cast<float>(model.params().base.wheel_radius_m));
+    } else {
+      const DoubleTrack model(double_track_params(config.model_params_yaml));
+      setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
+      setup.model_states = DoubleTrack::kNx;
+      setup.observe = observe_four_wheel<DoubleTrack>(static_cast<float>(model.params().base.wheel_radius_m));
+    }
+  } else if (config.model == "corrected") {
+    // Nominal + fitted effects (mppi-fit diagnose); a corrected plant shares its state layout.
+    if (config.model_params_yaml.empty()) throw Error("--model corrected needs --model-params FILE");
+    const CorrectedModelFile file = load_corrected_model(config.model_params_yaml);
+    const CorrectedSingleTrack model(file.nominal, file.effects);
+    setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
+    setup.model_states = CorrectedSingleTrack::kNx;
+    const float radius = static_cast<float>(file.nominal.wheel_radius_m);
+    setup.observe = [radius](const float* px, int plant_states, float* mx) {
+      if (plant_states == CorrectedSingleTrack::kNx) {
+        std::copy(px, px + CorrectedSingleTrack::kNx, mx);
+      } else {
+        std::fill(mx, mx + CorrectedSingleTrack::kNx, 0.f);
+        std::copy(px, px + std::min(plant_states, int{SingleTrack::kNx}), mx);
+        if (plant_states != SingleTrack::kNx)
+          mx[SingleTrack::kOmegaFront] = mx[SingleTrack::kOmegaRear] = px[state::kVx] / radius;
+      }
+    };
   } else {
     throw Error("unknown controller model '" + config.model +
-                "' (valid: autorally-nn, single-track, kinematic)");
+                "' (valid: autorally-nn, single-track, kinematic, corrected, double-track, full-vehicle)");
   }
   return setup;
 }
@@ -285,7 +343,17 @@ RunSummary run_closed_loop(const ClosedLoopConfig& config) {
                                                                             : config.network_npz),
                           track, cost);
   if (config.plant == "kinematic") return run_with_plant(config, KinematicBicycle(), track, cost);
-  throw Error("unknown plant '" + config.plant + "' (valid: single-track, autorally-nn, kinematic)");
+  if (config.plant == "double-track")
+    return run_with_plant(config, DoubleTrack(double_track_params(config.plant_params_yaml)), track, cost);
+  if (config.plant == "full-vehicle")
+    return run_with_plant(config, FullVehicle(full_vehicle_params(config.plant_params_yaml)), track, cost);
+  if (config.plant == "corrected") {
+    if (config.plant_params_yaml.empty()) throw Error("--plant corrected needs --plant-params FILE");
+    const CorrectedModelFile file = load_corrected_model(config.plant_params_yaml);
+    return run_with_plant(config, CorrectedSingleTrack(file.nominal, file.effects), track, cost);
+  }
+  throw Error("unknown plant '" + config.plant +
+              "' (valid: single-track, autorally-nn, kinematic, corrected, double-track, full-vehicle)");
 }
 
 }  // namespace mppi::sim

@@ -1,0 +1,337 @@
+// mppi-fit diagnose: sim-vs-real. Locates where a model disagrees with a recording, names the
+// missing physics from a library of candidate effects, writes the corrected model and shows
+// the held-out fit before and after (docs/DIAGNOSE.md). Sub-commands:
+//   mppi-fit diagnose --log FILE [...]     the diagnosis
+//   mppi-fit diagnose synth [...]          a synthetic recording with concealed effects
+//   mppi-fit diagnose sweep [...]          seeds x effects x sizes: named right / wrong, RMSE
+//   mppi-fit diagnose loop [...]           closed loop: MPPI with nominal vs corrected model
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "mppi/error.hpp"
+#include "mppi_fit_commands.hpp"
+#include "sim/closed_loop.hpp"
+#include "sim/recording.hpp"
+#include "sysid/diagnose/diagnose.hpp"
+#include "sysid/diagnose/synth.hpp"
+
+namespace {
+
+using namespace mppi;
+using namespace mppi::diagnose;
+
+const char* kUsage = R"(usage:
+  mppi-fit diagnose --log FILE [options]         locate, name, model, show (report in --out)
+    --log FILE          recording (docs/RECORDING_FORMAT.md)
+    --model NAME        nominal model: single-track (the one supported)     (single-track)
+    --params FILE       nominal parameters: single-track YAML or corrected-model file
+                        (default: the library defaults = data/config/autorally_single_track.yaml)
+    --log may also be a real recording (DART / ETH CSV, or ARCHIVE.zip:MEMBER.csv), converted
+                        on the fly (sysid/real_data.hpp)
+    --holdout H         held-out fraction at the end (0.3) or time range T0:T1 [s]
+    --validate FILE     fit on all of --log, judge on this other recording (replaces --holdout)
+    --effects A,B,...   candidate ids (default: all)
+    --max-effects N     at most N effects named                              (3)
+    --min-improvement F validation-cost reduction an effect must give        (0.05)
+    --min-bic-drop B    and BIC decrease                                     (2)
+    --out DIR           report.json, report.md, PNG plots, corrected_model.yaml (out/diagnose)
+    --no-plots          skip the PNG plots
+  mppi-fit diagnose synth --out FILE.csv [--effect key=value,...] [--seed N] [--duration S]
+                          [--speed V] [--samples K] [--track NAME] [--noise-scale F]
+  mppi-fit diagnose sweep [--seeds N] [--sizes small,large] [--effects A,B,...] [--clean N]
+                          [--duration S] [--min-bic-drop B] [--out DIR]
+                          (recordings already in DIR are reused)
+  mppi-fit diagnose loop --truth key=value,... --model-params FILE [--laps N] [--speed V]
+                         [--samples K] [--seed N] [--out DIR]
+Effect ids: aero_drag rolling_resistance steer_delay throttle_delay steer_lag throttle_lag
+steer_offset steer_gain tire_saturation friction_change load_transfer motor_voltage_sag road_grade
+)";
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+double number(const std::string& flag, const std::string& s) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(s, &used);
+    if (used == s.size()) return v;
+  } catch (const std::exception&) {
+  }
+  throw UsageError(flag + " expects a number, got '" + s + "'");
+}
+
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+int cmd_diagnose(int argc, char** argv) {
+  std::string log, params, validate, model = "single-track";
+  DiagnoseOptions o;
+  o.out_dir = "out/diagnose";
+  for (int i = 1; i < argc; ++i) {
+    const std::string f = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw UsageError(f + " needs a value");
+      return argv[++i];
+    };
+    if (f == "--log") log = value();
+    else if (f == "--model") model = value();
+    else if (f == "--params") params = value();
+    else if (f == "--holdout") o.holdout = value();
+    else if (f == "--validate") validate = value();
+    else if (f == "--effects") o.selection.candidates = split_list(value());
+    else if (f == "--max-effects") o.selection.max_effects = static_cast<int>(number(f, value()));
+    else if (f == "--min-improvement") o.selection.min_val_improvement = number(f, value());
+    else if (f == "--min-bic-drop") o.selection.min_bic_drop = number(f, value());
+    else if (f == "--out") o.out_dir = value();
+    else if (f == "--no-plots") o.plots = false;
+    else if (f == "--help" || f == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else throw UsageError("unknown option " + f);
+  }
+  if (log.empty()) throw UsageError("--log FILE is required");
+  if (model != "single-track") throw UsageError("--model: only single-track is supported, got '" + model + "'");
+  for (const auto& id : o.selection.candidates) effect_spec(id);  // throws for unknown ids
+  o.model_name = model;
+  o.params_source = params;
+  DiagData d = load_any(log);
+  if (!validate.empty()) {  // fit on --log, judge on --validate
+    const std::size_t first = d.rows();
+    d = concat(d, load_any(validate));
+    o.holdout = std::to_string(d.t[first] - 1e-6) + ":" + std::to_string(d.t.back() + 1.0);
+  }
+  const DiagnoseResult r = run_diagnosis(d, load_nominal(params), o);
+  std::printf("mismatch (strongest first):\n");
+  for (std::size_t i = 0; i < r.mismatch.size() && i < 8; ++i)
+    std::printf("  %-9s %-45s %+.3g %s (z %.1f)\n", r.mismatch[i].channel.c_str(), r.mismatch[i].where.c_str(),
+                r.mismatch[i].magnitude, r.mismatch[i].unit.c_str(), r.mismatch[i].z);
+  std::printf("selected:");
+  for (const auto& s : r.selection.selected) std::printf(" %s", s.c_str());
+  std::printf("%s\n", r.selection.selected.empty() ? " (none)" : "");
+  for (const auto& p : r.selection.final_params)
+    std::printf("  %s = %.4g +- %.2g %s\n", p.name.c_str(), p.value, p.stddev, p.unit.c_str());
+  std::printf("held-out normalised RMSE at 1 s: %.4f -> %.4f (%.1f %% reduction)\nreport: %s/report.md\n",
+              r.headline_before, r.headline_after, 100 * r.heldout_rmse_reduction, o.out_dir.c_str());
+  return 0;
+}
+
+int cmd_synth(int argc, char** argv) {
+  SynthOptions o;
+  std::string out;
+  for (int i = 2; i < argc; ++i) {
+    const std::string f = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw UsageError(f + " needs a value");
+      return argv[++i];
+    };
+    if (f == "--out") out = value();
+    else if (f == "--effect") o.truth_ids = parse_effect_assignments(value(), &o.truth);
+    else if (f == "--seed") o.seed = static_cast<std::uint64_t>(number(f, value()));
+    else if (f == "--duration") o.duration_s = number(f, value());
+    else if (f == "--speed") o.target_speed_mps = number(f, value());
+    else if (f == "--samples") o.samples = static_cast<int>(number(f, value()));
+    else if (f == "--track") o.track = value();
+    else if (f == "--noise-scale") o.noise.scale = number(f, value());
+    else throw UsageError("unknown option " + f);
+  }
+  if (out.empty()) throw UsageError("synth: --out FILE.csv is required");
+  o.work_dir = out + ".work";
+  const int crashes = synthesize(o, out);
+  std::printf("wrote %s (hidden effects: %zu, crashes %d)\n", out.c_str(), o.truth_ids.size(), crashes);
+  return 0;
+}
+
+int cmd_sweep(int argc, char** argv) {
+  int seeds = 2, clean = 4;
+  SelectionOptions sel;
+  double duration = 60;
+  std::vector<std::string> sizes = {"small", "large"}, effects;
+  std::string out = "out/diagnose_sweep";
+  for (int i = 2; i < argc; ++i) {
+    const std::string f = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw UsageError(f + " needs a value");
+      return argv[++i];
+    };
+    if (f == "--seeds") seeds = static_cast<int>(number(f, value()));
+    else if (f == "--clean") clean = static_cast<int>(number(f, value()));
+    else if (f == "--sizes") sizes = split_list(value());
+    else if (f == "--effects") effects = split_list(value());
+    else if (f == "--duration") duration = number(f, value());
+    else if (f == "--out") out = value();
+    else if (f == "--min-bic-drop") sel.min_bic_drop = number(f, value());
+    else throw UsageError("unknown option " + f);
+  }
+  std::filesystem::create_directories(out);
+  struct Row {
+    std::string truth, size, named;
+    int seed;
+    bool right, wrong;
+    double reduction;
+  };
+  std::vector<Row> rows;
+  auto run_one = [&](const std::string& id, const std::string& size, const std::string& assign, int seed) {
+    SynthOptions so;
+    so.seed = static_cast<std::uint64_t>(seed);
+    so.duration_s = duration;
+    if (!assign.empty()) so.truth_ids = parse_effect_assignments(assign, &so.truth);
+    const std::string name = (id.empty() ? "none" : id) + "_" + size + "_s" + std::to_string(seed);
+    so.work_dir = out + "/work/" + name;
+    const std::string csv = out + "/" + name + ".csv";
+    if (!std::filesystem::exists(csv)) synthesize(so, csv);  // a rerun reuses the recordings
+    DiagnoseOptions o;
+    o.plots = false;
+    o.selection = sel;
+    const DiagnoseResult r = run_diagnosis(load_recording(csv), SingleTrackParams{}, o);
+    Row row{id.empty() ? "none" : id, size, "", seed, false, false, r.heldout_rmse_reduction};
+    for (const auto& s : r.selection.selected) {
+      row.named += (row.named.empty() ? "" : "+") + s;
+      if (std::find(so.truth_ids.begin(), so.truth_ids.end(), s) != so.truth_ids.end()) row.right = true;
+      else row.wrong = true;
+    }
+    if (row.named.empty()) row.named = "-";
+    std::printf("%-20s %-6s seed %2d  named %-34s right %d wrong %d  held-out RMSE reduction %6.1f %%\n",
+                row.truth.c_str(), size.c_str(), seed, row.named.c_str(), row.right, row.wrong, 100 * row.reduction);
+    std::fflush(stdout);
+    rows.push_back(row);
+  };
+  for (const auto& c : sweep_cases()) {
+    if (!effects.empty() && std::find(effects.begin(), effects.end(), c.id) == effects.end()) continue;
+    for (const auto& size : sizes)
+      for (int s = 1; s <= seeds; ++s) run_one(c.id, size, size == "small" ? c.small : c.large, s);
+  }
+  for (int s = 1; s <= clean; ++s) run_one("", "clean", "", 100 + s);
+  // Summary table.
+  std::ostringstream md;
+  md << "| truth | size | runs | right named | wrong named | median held-out RMSE reduction |\n|---|---|---|---|---|---|\n";
+  int eff_runs = 0, eff_right = 0, eff_wrong = 0, clean_runs = 0, clean_named = 0, big_red = 0;
+  std::vector<std::string> keys;
+  for (const auto& r : rows)
+    if (std::find(keys.begin(), keys.end(), r.truth + "|" + r.size) == keys.end()) keys.push_back(r.truth + "|" + r.size);
+  for (const auto& k : keys) {
+    int n = 0, right = 0, wrong = 0;
+    std::vector<double> red;
+    for (const auto& r : rows)
+      if (r.truth + "|" + r.size == k) {
+        ++n;
+        right += r.right;
+        wrong += r.wrong;
+        red.push_back(r.reduction);
+      }
+    std::sort(red.begin(), red.end());
+    const auto bar = k.find('|');
+    char line[256];
+    std::snprintf(line, sizeof line, "| %s | %s | %d | %d | %d | %.1f %% |\n", k.substr(0, bar).c_str(),
+                  k.substr(bar + 1).c_str(), n, right, wrong, 100 * red[red.size() / 2]);
+    md << line;
+  }
+  for (const auto& r : rows) {
+    if (r.truth == "none") {
+      ++clean_runs;
+      clean_named += r.named != "-";
+    } else {
+      ++eff_runs;
+      eff_right += r.right;
+      eff_wrong += r.wrong;
+      big_red += r.reduction >= 0.5;
+    }
+  }
+  char tail[512];
+  std::snprintf(tail, sizeof tail,
+                "\nWith an effect: right effect named in %d/%d (%.0f %%), a wrong effect named in %d/%d (%.0f %%), "
+                "held-out 1-s RMSE reduced >= 50 %% in %d/%d.\nNo effect: something named in %d/%d.\n",
+                eff_right, eff_runs, eff_runs ? 100.0 * eff_right / eff_runs : 0.0, eff_wrong, eff_runs,
+                eff_runs ? 100.0 * eff_wrong / eff_runs : 0.0, big_red, eff_runs, clean_named, clean_runs);
+  md << tail;
+  std::printf("\n%s", md.str().c_str());
+  std::ofstream(out + "/sweep.md") << md.str();
+  return 0;
+}
+
+int cmd_loop(int argc, char** argv) {
+  sim::ClosedLoopConfig base;
+  base.plant = "corrected";
+  base.laps = 3;
+  base.target_speed_mps = 8.0;
+  base.controller.num_samples = 1024;
+  base.controller.horizon = 100;
+  base.progress = false;
+  base.actuators.steer_rate_per_s = 1e4f;
+  base.actuators.throttle_rate_per_s = 1e4f;
+  std::string truth_text, model_params, out = "out/diagnose_loop";
+  for (int i = 2; i < argc; ++i) {
+    const std::string f = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw UsageError(f + " needs a value");
+      return argv[++i];
+    };
+    if (f == "--truth") truth_text = value();
+    else if (f == "--model-params") model_params = value();
+    else if (f == "--laps") base.laps = static_cast<int>(number(f, value()));
+    else if (f == "--speed") base.target_speed_mps = number(f, value());
+    else if (f == "--samples") base.controller.num_samples = static_cast<int>(number(f, value()));
+    else if (f == "--seed") base.controller.seed = static_cast<std::uint64_t>(number(f, value()));
+    else if (f == "--track") base.track = value();
+    else if (f == "--out") out = value();
+    else throw UsageError("unknown option " + f);
+  }
+  if (model_params.empty()) throw UsageError("loop: --model-params FILE (the corrected model) is required");
+  std::filesystem::create_directories(out);
+  CorrectedModelFile truth;
+  truth.selected = parse_effect_assignments(truth_text, &truth.effects);
+  base.plant_params_yaml = out + "/truth_model.yaml";
+  std::ofstream(base.plant_params_yaml) << corrected_model_to_yaml(truth, "truth plant of mppi-fit diagnose loop");
+  std::printf("| controller model | laps | lap times [s] | crashes | mean speed [m/s] | mean |v - v_target| [m/s] |\n|---|---|---|---|---|---|\n");
+  for (const std::string model : {"single-track", "corrected"}) {
+    sim::ClosedLoopConfig c = base;
+    c.model = model;
+    if (model == "corrected") c.model_params_yaml = model_params;
+    c.out_dir = out + "/" + model;
+    const sim::RunSummary s = sim::run_closed_loop(c);
+    const sim::Recording rec = sim::RecordingReader::read(c.out_dir + "/log.csv");
+    double err = 0;
+    const auto& vx = rec.column("vx");
+    const auto& vy = rec.column("vy");
+    for (std::size_t k = 0; k < rec.rows(); ++k) err += std::abs(std::hypot(vx[k], vy[k]) - c.target_speed_mps);
+    std::string laps;
+    for (double t : s.lap_times_s) {
+      char b[16];
+      std::snprintf(b, sizeof b, "%s%.2f", laps.empty() ? "" : ", ", t);
+      laps += b;
+    }
+    std::printf("| %s | %d/%d | %s | %d | %.2f | %.2f |\n", model == "corrected" ? "corrected (nominal + effects)" : "nominal single-track",
+                s.laps_completed, c.laps, laps.c_str(), s.crashes, s.mean_speed_mps, rec.rows() ? err / rec.rows() : 0.0);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int mppi_fit_diagnose(int argc, char** argv) {
+  try {
+    const std::string sub = argc > 1 ? argv[1] : "";
+    if (sub == "synth") return cmd_synth(argc, argv);
+    if (sub == "sweep") return cmd_sweep(argc, argv);
+    if (sub == "loop") return cmd_loop(argc, argv);
+    return cmd_diagnose(argc, argv);
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "mppi-fit diagnose: %s\n%s", e.what(), kUsage);
+    return 2;
+  } catch (const mppi::Error& e) {
+    std::fprintf(stderr, "mppi-fit diagnose: error: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,421 @@
+// mppi-fit estimate: joint-state UKF / ALM-UKF parameter estimation from a recording, with
+// convergence (CSV + PNG), estimated parameters (YAML for mppi-sim / the controller), and an
+// open-loop validation on held-out data against the nominal parameters. docs/ESTIMATION.md.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "dynamics/vehicle_params.hpp"
+#include "mppi/error.hpp"
+#include "mppi_fit_commands.hpp"
+#include "sim/data_dir.hpp"
+#include "sysid/estimation_plots.hpp"
+#include "sysid/observability.hpp"
+#include "sysid/real_data.hpp"
+#include "sysid/vehicle_estimation.hpp"
+
+namespace {
+
+const char* kEstimateUsage = R"(usage: mppi-fit estimate RECORDING [options]
+  RECORDING            a recording (docs/RECORDING_FORMAT.md), or a shipped raw one converted on
+                       the fly: real/dart_jetracer.zip:<member>.csv (see mppi-fit convert --list)
+  --model NAME         single-track | double-track | full-vehicle          (single-track)
+  --params FILE        base parameters (YAML of that model; default data/config/autorally_<model>.yaml)
+  --estimate A,B,...   parameters to estimate (YAML keys, tyre.B etc.; default: see --list-params)
+  --list-params        print the parameter names of the model and exit
+  --estimator NAME     alm (ALM-UKF) | ukf (standard joint-state UKF)      (alm)
+  --alm-window S       noise samples from the last S seconds               (10)
+  --alm-process        also re-estimate Q (off: Q and R together drift, see docs)
+  --fit T0:T1          fit on rows with t in [T0, T1) s                    (all)
+  --validate T0:T1     held-out rows of the same recording for validation
+  --validate-recording FILE   held-out recording (instead of a window)
+  --horizon S          validation rollouts restarted every S seconds       (1)
+  --measure A,B,...    recording columns used as measurements (default: all the model has)
+  --meas-std C=SD,...  measurement noise std overrides (initial R for the ALM)
+  --param-std F        initial std of log(parameter) (linear ones: absolute) (0.3)
+  --walk-std F         parameter random walk per sqrt(s), rescaled each step (0.003)
+  --process-scale F    scale of the model's process noise                  (1)
+  --keep-wheelbase     estimating cg_to_front_axle_m moves the CG, wheelbase fixed
+  --truth FILE         true parameters (simulated data): report each parameter's error
+  --observability      print the observability check of the joint-state model and exit
+  --rank-tol F         singular values below F x the largest count as zero (1e-7)
+  --out DIR            estimated.yaml, convergence.csv/.png, validation.png, parameters.csv,
+                       summary.txt                                         (out/estimate)
+)";
+
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+double number(const std::string& flag, const std::string& s) {
+  std::size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(s, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != s.size() || s.empty()) throw mppi::Error(flag + " expects a number, got '" + s + "'");
+  return v;
+}
+
+std::pair<double, double> window(const std::string& flag, const std::string& s) {
+  const std::size_t c = s.find(':');
+  if (c == std::string::npos) throw mppi::Error(flag + " expects T0:T1, got '" + s + "'");
+  return {number(flag, s.substr(0, c)), number(flag, s.substr(c + 1))};
+}
+
+std::string resolve(const std::string& spec) {
+  if (spec.rfind("real/", 0) != 0) return spec;
+  const std::size_t z = spec.find(".zip:");
+  return z == std::string::npos ? mppi::sim::data_file(spec)
+                                : mppi::sim::data_file(spec.substr(0, z + 4)) + spec.substr(z + 4);
+}
+
+}  // namespace
+
+int mppi_fit_estimate(int argc, char** argv) {
+  using namespace mppi;
+  using namespace mppi::sysid;
+  std::string input, model = "single-track", params_file, out_dir = "out/estimate", truth_file, val_file;
+  std::vector<std::string> estimate_names;
+  EstimateSettings st;
+  bool have_fit = false, have_val = false, list_params = false, observe = false, keep_wheelbase = false;
+  std::pair<double, double> fit{-1e300, 1e300}, val{0, 0};
+  double horizon_s = 1.0, rank_tol = 1e-7;
+  try {
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      auto value = [&]() -> std::string {
+        if (i + 1 >= argc) throw Error(a + " expects a value");
+        return argv[++i];
+      };
+      if (a == "--help" || a == "-h") {
+        std::fputs(kEstimateUsage, stdout);
+        return 0;
+      } else if (a == "--model") {
+        model = value();
+        if (model != "single-track" && model != "double-track" && model != "full-vehicle")
+          throw Error("--model expects single-track, double-track or full-vehicle, got '" + model + "'");
+      } else if (a == "--params") {
+        params_file = value();
+      } else if (a == "--estimate") {
+        estimate_names = split_list(value());
+      } else if (a == "--list-params") {
+        list_params = true;
+      } else if (a == "--estimator") {
+        const std::string e = value();
+        if (e != "alm" && e != "ukf") throw Error("--estimator expects alm or ukf, got '" + e + "'");
+        st.adaptive = e == "alm";
+      } else if (a == "--alm-window") {
+        st.alm_window_s = number(a, value());
+      } else if (a == "--alm-process") {
+        st.alm_process = true;
+      } else if (a == "--fit") {
+        fit = window(a, value());
+        have_fit = true;
+      } else if (a == "--validate") {
+        val = window(a, value());
+        have_val = true;
+      } else if (a == "--validate-recording") {
+        val_file = value();
+      } else if (a == "--horizon") {
+        horizon_s = number(a, value());
+      } else if (a == "--measure") {
+        st.measure = split_list(value());
+      } else if (a == "--meas-std") {
+        for (const auto& kv : split_list(value())) {
+          const std::size_t eq = kv.find('=');
+          if (eq == std::string::npos) throw Error("--meas-std expects COLUMN=STD, got '" + kv + "'");
+          st.measurement_std.emplace_back(kv.substr(0, eq), number(a, kv.substr(eq + 1)));
+        }
+      } else if (a == "--param-std") {
+        st.param_initial_std = number(a, value());
+      } else if (a == "--walk-std") {
+        st.param_walk_std_per_s = number(a, value());
+      } else if (a == "--process-scale") {
+        st.process_noise_scale = number(a, value());
+      } else if (a == "--keep-wheelbase") {
+        keep_wheelbase = true;
+      } else if (a == "--truth") {
+        truth_file = value();
+      } else if (a == "--observability") {
+        observe = true;
+      } else if (a == "--rank-tol") {
+        rank_tol = number(a, value());
+      } else if (a == "--out") {
+        out_dir = value();
+      } else if (!a.empty() && a[0] == '-') {
+        throw Error("unknown option " + a);
+      } else if (input.empty()) {
+        input = a;
+      } else {
+        throw Error("more than one recording given");
+      }
+    }
+    if (list_params) {
+      for (const auto& n : model == "single-track"   ? single_track_param_names()
+                           : model == "double-track" ? double_track_param_names()
+                                                     : full_vehicle_param_names())
+        std::printf("%s\n", n.c_str());
+      return 0;
+    }
+    if (input.empty()) throw Error("no recording given");
+    if (have_fit) {
+      st.t_begin_s = fit.first;
+      st.t_end_s = fit.second;
+    }
+    std::string why;
+    if (!st.is_valid(&why)) throw Error(why);
+    if (!(horizon_s > 0)) throw Error("--horizon must be > 0");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mppi-fit estimate: %s\n%s", e.what(), kEstimateUsage);
+    return 2;
+  }
+
+  try {
+    // Model and its base parameters.
+    VehicleModelSpec spec, truth_spec;
+    bool have_truth = !truth_file.empty();
+    if (model == "single-track") {
+      const SingleTrackParams base = load_single_track_params(
+          params_file.empty() ? sim::data_file("config/autorally_single_track.yaml") : params_file);
+      if (estimate_names.empty())
+        estimate_names = {"yaw_inertia_kgm2", "cg_to_front_axle_m", "tyre.B", "tyre.C", "tyre.D"};
+      spec = single_track_spec(base, estimate_names, keep_wheelbase);
+      if (have_truth) truth_spec = single_track_spec(load_single_track_params(truth_file), estimate_names);
+    } else if (model == "double-track") {
+      const DoubleTrackParams base = load_double_track_params(
+          params_file.empty() ? sim::data_file("config/autorally_double_track.yaml") : params_file);
+      if (estimate_names.empty())
+        estimate_names = {"mass_kg", "yaw_inertia_kgm2", "rear_wheel_inertia_kgm2", "cg_height_m",
+                          "cg_to_front_axle_m", "tyre.B", "tyre.C", "tyre.D"};
+      spec = double_track_spec(base, estimate_names, keep_wheelbase);
+      if (have_truth) truth_spec = double_track_spec(load_double_track_params(truth_file), estimate_names);
+    } else {
+      const FullVehicleParams base = load_full_vehicle_params(
+          params_file.empty() ? sim::data_file("config/autorally_full_vehicle.yaml") : params_file);
+      if (estimate_names.empty())
+        estimate_names = {"mass_kg", "yaw_inertia_kgm2", "rear_wheel_inertia_kgm2", "cg_height_m",
+                          "cg_to_front_axle_m", "tyre.B", "tyre.C", "tyre.D",
+                          "front_damper_Nspm", "rear_damper_Nspm"};
+      spec = full_vehicle_spec(base, estimate_names, keep_wheelbase);
+      if (have_truth) truth_spec = full_vehicle_spec(load_full_vehicle_params(truth_file), estimate_names);
+    }
+    const sim::Recording rec = load_any_recording(resolve(input));
+    const std::size_t np = spec.estimated.size();
+    std::vector<double> truth(np, NAN);
+    if (have_truth) truth = truth_spec.nominal;
+
+    if (observe) {
+      // Joint-state model [x; p] along the measured trajectory of the fit window (up to 200
+      // points), transitions over the sampling interval, measurements = the measured columns.
+      const auto& t = rec.column("t");
+      std::vector<std::size_t> rows;
+      for (std::size_t i = 0; i < rec.rows(); ++i)
+        if (t[i] >= st.t_begin_s && t[i] < st.t_end_s) rows.push_back(i);
+      if (rows.size() < 3) throw Error("--observability: fewer than 3 rows in the fit window");
+      std::vector<int> idx;
+      std::vector<std::string> names = spec.state_names;
+      for (const auto& [col, i] : spec.measurable)
+        if (rec.has_column(col) && (st.measure.empty() || std::find(st.measure.begin(), st.measure.end(), col) != st.measure.end()))
+          idx.push_back(i);
+      for (const auto& n : spec.estimated) names.push_back(n);
+      const int nx = spec.nx;
+      TransitionFn F = [&spec, nx, np](const Vec& xa, const Vec& u) -> Vec {
+        std::vector<double> v(xa.data() + nx, xa.data() + nx + np);
+        Vec out = xa;
+        const double uu[2] = {u(0), u(1)};
+        spec.step(v, out.data(), uu, u(2));
+        return out;
+      };
+      MeasurementFn H = [idx](const Vec& xa, const Vec&) -> Vec {
+        Vec y(static_cast<int>(idx.size()));
+        for (std::size_t i = 0; i < idx.size(); ++i) y(i) = xa(idx[i]);
+        return y;
+      };
+      const std::size_t n_pts = std::min<std::size_t>(200, rows.size() - 1);
+      const std::size_t start = (rows.size() - 1 - n_pts) / 2;
+      std::vector<Vec> xs, us;
+      Vec scale(nx + static_cast<int>(np));
+      for (int i = 0; i < nx; ++i) scale(i) = 1.0;
+      for (std::size_t j = 0; j < np; ++j) scale(nx + j) = std::max(1e-3, std::abs(spec.nominal[j]));
+      for (std::size_t k = 0; k < n_pts; ++k) {
+        const std::size_t r = rows[start + k];
+        Vec xa(nx + static_cast<int>(np));
+        spec.init_state(rec, r, xa.data());
+        for (std::size_t j = 0; j < np; ++j) xa(nx + j) = spec.nominal[j];
+        Vec u(3);
+        u << rec.column("steer")[r], rec.column("throttle")[r], t[r + 1] - t[r];
+        xs.push_back(xa);
+        us.push_back(u);
+      }
+      ObservabilitySettings os;
+      os.rank_tolerance = rank_tol;
+      const ObservabilityReport rep = observability(F, H, xs, us, scale, os);
+      std::printf("observability of the joint %s model (%d states + %zu parameters) over %zu samples,"
+                  " t %.2f..%.2f s, measured %zu channels:\n%s\n", spec.kind.c_str(), nx, np, n_pts,
+                  t[rows[start]], t[rows[start + n_pts - 1]], idx.size(), rep.describe(names).c_str());
+      std::printf("smallest singular values:");
+      for (int i = std::max(0, static_cast<int>(rep.singular_values.size()) - 5); i < rep.singular_values.size(); ++i)
+        std::printf(" %.3g", rep.singular_values(i));
+      std::printf("\n");
+      return rep.full_rank() ? 0 : 3;
+    }
+
+    std::printf("estimating %zu %s parameters with the %s on %s (%zu rows)\n", np, spec.kind.c_str(),
+                st.adaptive ? "ALM-UKF" : "joint-state UKF", input.c_str(), rec.rows());
+    const EstimateResult res = estimate_parameters(spec, rec, st);
+    std::filesystem::create_directories(out_dir);
+
+    // Parameters and convergence.
+    {
+      std::ofstream y(out_dir + "/estimated.yaml");
+      y << "# " << spec.kind << " parameters estimated by mppi-fit estimate (" << (st.adaptive ? "ALM-UKF" : "joint-state UKF")
+        << ") from " << input << "\n# estimated: ";
+      for (std::size_t i = 0; i < np; ++i) y << (i ? ", " : "") << spec.estimated[i];
+      y << "\n" << spec.to_yaml(res.final_values);
+      if (!y) throw Error(out_dir + "/estimated.yaml: cannot write");
+    }
+    // The file must load in the simulator and the controller: parse it back with their loader.
+    try {
+      if (model == "single-track")
+        (void)load_single_track_params(out_dir + "/estimated.yaml");
+      else if (model == "double-track")
+        (void)load_double_track_params(out_dir + "/estimated.yaml");
+      else
+        (void)load_full_vehicle_params(out_dir + "/estimated.yaml");
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "mppi-fit estimate: WARNING: the estimated parameters do not load: %s\n", e.what());
+    }
+    {
+      std::ofstream c(out_dir + "/convergence.csv");
+      c << "t";
+      for (const auto& n : res.names) c << "," << n << "," << n << "_std";
+      c << "\n";
+      for (std::size_t k = 0; k < res.t.size(); ++k) {
+        c << res.t[k];
+        for (std::size_t i = 0; i < np; ++i) c << "," << res.history[k][i] << "," << res.history_std[k][i];
+        c << "\n";
+      }
+    }
+    std::vector<PlotPanel> conv;
+    for (std::size_t i = 0; i < np; ++i) {
+      PlotPanel p;
+      p.title = res.names[i];
+      p.x_label = "t [s]";
+      PlotSeries s, lo, hi;
+      for (std::size_t k = 0; k < res.t.size(); ++k) {
+        s.x.push_back(res.t[k]);
+        s.y.push_back(res.history[k][i]);
+        lo.y.push_back(res.history[k][i] - 2 * res.history_std[k][i]);
+        hi.y.push_back(res.history[k][i] + 2 * res.history_std[k][i]);
+      }
+      lo.x = hi.x = s.x;
+      lo.colour = hi.colour = 4;
+      lo.dashed = hi.dashed = true;
+      s.label = "estimate";
+      hi.label = "+-2 sd";
+      p.series = {lo, hi, s};
+      if (have_truth) p.hlines.push_back(truth[i]);
+      conv.push_back(p);
+    }
+    write_panels_png(out_dir + "/convergence.png",
+                     std::string(st.adaptive ? "ALM-UKF" : "joint-state UKF") + " parameter convergence" +
+                         (have_truth ? " (dashed grey: true value)" : ""), conv, 3, 380, 220);
+
+    // Validation: held-out window or recording, estimated vs nominal parameters.
+    sim::Recording val_rec;
+    std::size_t vb = 0, ve = 0;
+    bool validate = false;
+    if (!val_file.empty()) {
+      val_rec = load_any_recording(resolve(val_file));
+      vb = 0;
+      ve = val_rec.rows();
+      validate = true;
+    } else if (have_val) {
+      val_rec = rec;
+      vb = row_at_time(rec, val.first);
+      ve = row_at_time(rec, val.second);
+      validate = ve > vb + 1;
+    }
+    ValidationResult ve_est, ve_nom;
+    if (validate) {
+      ve_est = validate_parameters(spec, res.final_values, val_rec, vb, ve, horizon_s);
+      ve_nom = validate_parameters(spec, spec.nominal, val_rec, vb, ve, horizon_s);
+      std::vector<PlotPanel> panels;
+      PlotPanel path;
+      path.title = "path (open loop from the first state)";
+      path.x_label = "x [m]";
+      path.equal_axes = true;
+      PlotSeries m{ve_est.measured[0], ve_est.measured[1], 0, "measured"};
+      PlotSeries e{ve_est.simulated[0], ve_est.simulated[1], 1, "estimated"};
+      PlotSeries n{ve_nom.simulated[0], ve_nom.simulated[1], 4, "nominal", true};
+      path.series = {m, n, e};
+      panels.push_back(path);
+      for (int c : {3, 4, 5, 2}) {
+        PlotPanel p;
+        p.title = ve_est.channels[c] + " (open loop)";
+        p.x_label = "t [s]";
+        p.series = {{ve_est.t, ve_est.measured[c], 0, "measured"},
+                    {ve_est.t, ve_nom.simulated[c], 4, "nominal", true},
+                    {ve_est.t, ve_est.simulated[c], 1, "estimated"}};
+        panels.push_back(p);
+      }
+      write_panels_png(out_dir + "/validation.png", "held-out validation: model with estimated vs nominal parameters",
+                       panels, 3, 420, 300);
+    }
+
+    // Tables.
+    std::ostringstream sum;
+    sum << "model " << spec.kind << ", estimator " << (st.adaptive ? "ALM-UKF" : "joint-state UKF") << ", recording "
+        << input << "\nfit: " << res.steps << " steps, t " << res.t.front() << ".." << res.t.back() << " s, "
+        << res.wall_s << " s wall, PD projections " << res.projections << ", rejected steps " << res.rejected_steps
+        << "\nmeasured:";
+    for (std::size_t i = 0; i < res.measured.size(); ++i)
+      sum << " " << res.measured[i] << " (innovation rms " << res.innovation_rms[i] << ", noise std "
+          << res.measurement_std[i] << ")";
+    sum << "\n\nparameter                    initial     estimate    2sd         truth       error%   converged(2%) s\n";
+    std::ofstream pc(out_dir + "/parameters.csv");
+    pc << "name,initial,estimate,std,truth,error_pct,converged_2pct_s,converged_5pct_s\n";
+    for (std::size_t i = 0; i < np; ++i) {
+      const double err = have_truth ? 100.0 * (res.final_values[i] - truth[i]) / truth[i] : NAN;
+      const double c2 = convergence_time(res, i, 0.02), c5 = convergence_time(res, i, 0.05);
+      char line[256];
+      std::snprintf(line, sizeof line, "%-28s %-11.5g %-11.5g %-11.3g %-11.5g %-8.2f %.1f\n", res.names[i].c_str(),
+                    res.initial[i], res.final_values[i], 2 * res.final_std[i], truth[i], err, c2 - res.t.front());
+      sum << line;
+      pc << res.names[i] << "," << res.initial[i] << "," << res.final_values[i] << "," << res.final_std[i] << ","
+         << truth[i] << "," << err << "," << c2 - res.t.front() << "," << c5 - res.t.front() << "\n";
+    }
+    if (validate) {
+      sum << "\nvalidation (" << ve - vb << " rows): rms error, estimated vs nominal parameters\n"
+          << "channel     open-loop est   open-loop nom   " << horizon_s << "s-rollouts est   " << horizon_s
+          << "s-rollouts nom\n";
+      for (std::size_t c = 0; c < ve_est.channels.size(); ++c) {
+        char line[200];
+        std::snprintf(line, sizeof line, "%-10s  %-14.4g  %-14.4g  %-17.4g  %-14.4g\n", ve_est.channels[c].c_str(),
+                      ve_est.open_loop_rms[c], ve_nom.open_loop_rms[c], ve_est.horizon_rms[c], ve_nom.horizon_rms[c]);
+        sum << line;
+      }
+    }
+    std::ofstream(out_dir + "/summary.txt") << sum.str();
+    std::fputs(sum.str().c_str(), stdout);
+    std::printf("wrote %s/{estimated.yaml, convergence.csv, convergence.png, parameters.csv, summary.txt%s}\n",
+                out_dir.c_str(), validate ? ", validation.png" : "");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mppi-fit estimate: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,131 @@
+#include "sysid/diagnose/data.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mppi/error.hpp"
+#include "sysid/real_data.hpp"
+
+namespace mppi::diagnose {
+
+DiagData prepare(const sim::Recording& rec, const std::string& source, std::size_t min_rows) {
+  DiagData d;
+  d.source = source;
+  for (const auto& c : sim::kRecordingRequiredColumns)
+    if (!rec.has_column(c)) throw Error(source + ": missing required column '" + c + "'");
+  d.t = rec.column("t");
+  d.x = rec.column("x");
+  d.y = rec.column("y");
+  d.yaw = rec.column("yaw");
+  d.vx = rec.column("vx");
+  d.vy = rec.column("vy");
+  d.r = rec.column("yaw_rate");
+  d.steer = rec.column("steer");
+  d.throttle = rec.column("throttle");
+  const auto src = rec.metadata.find("source");
+  d.control_lead = (src != rec.metadata.end() &&
+                    (src->second == "mppi-sim" || src->second.rfind("mppi-fit synth", 0) == 0))
+                       ? 1 : 0;
+  const std::size_t n = d.t.size();
+  if (n < min_rows)
+    throw Error(source + ": too short for diagnosis: " + std::to_string(n) + " rows, need at least " +
+                std::to_string(min_rows));
+  std::vector<double> dts;
+  for (std::size_t k = 1; k < n; ++k) dts.push_back(d.t[k] - d.t[k - 1]);
+  std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
+  d.dt_s = dts[dts.size() / 2];
+  if (!(d.dt_s > 0)) throw Error(source + ": cannot determine the sample interval");
+  // Pieces: cut at NaN rows, gaps > 3 median intervals, and position jumps no car makes.
+  d.piece.assign(n, -1);
+  int id = -1;
+  bool open = false;
+  std::size_t usable = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double vals[] = {d.t[k], d.x[k], d.y[k], d.yaw[k], d.vx[k], d.vy[k], d.r[k], d.steer[k], d.throttle[k]};
+    bool ok = true;
+    for (double v : vals) ok = ok && std::isfinite(v);
+    if (!ok) {
+      open = false;
+      continue;
+    }
+    if (open && k > 0) {
+      const double gap = d.t[k] - d.t[k - 1];
+      const double jump = std::hypot(d.x[k] - d.x[k - 1], d.y[k] - d.y[k - 1]);
+      const double vmax = std::max(std::abs(d.vx[k]), std::abs(d.vx[k - 1])) + 2.0;
+      if (gap > 3 * d.dt_s || jump > 3 * vmax * gap + 0.2) open = false;
+    }
+    if (!open) {
+      ++id;
+      open = true;
+    }
+    d.piece[k] = id;
+    ++usable;
+  }
+  if (usable < min_rows)
+    throw Error(source + ": only " + std::to_string(usable) + " usable rows (no empty fields), need " +
+                std::to_string(min_rows));
+  return d;
+}
+
+DiagData load_recording(const std::string& path) {
+  return prepare(sim::RecordingReader::read(path), path);
+}
+
+DiagData concat(const DiagData& a, const DiagData& b) {
+  if (a.control_lead != b.control_lead)
+    throw Error(a.source + " and " + b.source + ": recordings of different kinds (command timing) cannot be combined");
+  DiagData d = a;
+  d.source = a.source + " + " + b.source;
+  const double shift = a.t.back() + 10.0 - b.t.front();
+  int max_piece = -1;
+  for (int p : a.piece) max_piece = std::max(max_piece, p);
+  auto append = [](std::vector<double>& to, const std::vector<double>& from, double add) {
+    for (double v : from) to.push_back(v + add);
+  };
+  append(d.t, b.t, shift);
+  append(d.x, b.x, 0);
+  append(d.y, b.y, 0);
+  append(d.yaw, b.yaw, 0);
+  append(d.vx, b.vx, 0);
+  append(d.vy, b.vy, 0);
+  append(d.r, b.r, 0);
+  append(d.steer, b.steer, 0);
+  append(d.throttle, b.throttle, 0);
+  for (int p : b.piece) d.piece.push_back(p < 0 ? -1 : p + max_piece + 1);
+  return d;
+}
+
+DiagData load_any(const std::string& spec) {
+  return prepare(sysid::load_any_recording(spec), spec);
+}
+
+Split make_split(const DiagData& d, const std::string& holdout) {
+  Split s;
+  s.heldout.assign(d.rows(), 0);
+  const auto colon = holdout.find(':');
+  try {
+    if (colon == std::string::npos) {
+      std::size_t used = 0;
+      const double f = std::stod(holdout, &used);
+      if (used != holdout.size() || !(f > 0.05 && f < 0.95)) throw std::invalid_argument(holdout);
+      const auto first = static_cast<std::size_t>((1.0 - f) * static_cast<double>(d.rows()));
+      for (std::size_t k = first; k < d.rows(); ++k) s.heldout[k] = 1;
+    } else {
+      const double t0 = std::stod(holdout.substr(0, colon));
+      const double t1 = std::stod(holdout.substr(colon + 1));
+      if (!(t1 > t0)) throw std::invalid_argument(holdout);
+      for (std::size_t k = 0; k < d.rows(); ++k) s.heldout[k] = d.t[k] >= t0 && d.t[k] < t1;
+    }
+  } catch (const std::logic_error&) {
+    throw Error("--holdout: expected a fraction in (0.05, 0.95) or a time range T0:T1 in s, got '" +
+                holdout + "'");
+  }
+  std::size_t h = 0;
+  for (char c : s.heldout) h += c;
+  if (h < 100 || d.rows() - h < 150)
+    throw Error(d.source + ": --holdout " + holdout + " leaves " + std::to_string(d.rows() - h) +
+                " training and " + std::to_string(h) + " held-out rows (need >= 150 and >= 100)");
+  return s;
+}
+
+}  // namespace mppi::diagnose

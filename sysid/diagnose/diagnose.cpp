@@ -1,0 +1,216 @@
+#include "sysid/diagnose/diagnose.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "mppi/error.hpp"
+#include "sysid/diagnose/plots.hpp"
+
+namespace mppi::diagnose {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json metrics_json(const std::vector<HorizonMetrics>& ms) {
+  json out = json::array();
+  for (const auto& m : ms) {
+    json j;
+    j["horizon_s"] = m.horizon_s;
+    j["starts"] = m.starts;
+    for (int c = 0; c < kChannels; ++c) {
+      j["rmse"][kChannelNames[c]] = num(m.rmse[c]);
+      j["fit_percent"][kChannelNames[c]] = num(m.fit_percent[c]);
+    }
+    j["position_rmse_m"] = num(m.position_rmse_m);
+    j["normalized_rmse"] = num(m.normalized_rmse);
+    out.push_back(j);
+  }
+  return out;
+}
+
+const HorizonMetrics* at_horizon(const std::vector<HorizonMetrics>& ms, double h) {
+  for (const auto& m : ms)
+    if (std::abs(m.horizon_s - h) < 1e-9) return &m;
+  return nullptr;
+}
+
+}  // namespace
+
+SingleTrackParams load_nominal(const std::string& path) {
+  if (path.empty()) return SingleTrackParams{};
+  std::ifstream in(path);
+  if (!in) throw Error("cannot open nominal parameter file '" + path + "'");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  if (text.find("nominal_params") != std::string::npos) return corrected_model_from_yaml(text, path).nominal;
+  return single_track_params_from_yaml(text, path);
+}
+
+DiagnoseResult run_diagnosis(const DiagData& d, const SingleTrackParams& nominal, const DiagnoseOptions& o) {
+  DiagnoseResult res;
+  const Split split = make_split(d, o.holdout);
+  std::vector<char> train(d.rows()), held = split.heldout;
+  for (std::size_t k = 0; k < d.rows(); ++k) train[k] = !held[k];
+  const CorrectedSingleTrack nominal_model(nominal);
+
+  // 1. Locate (training part: the held-out part is kept for judging the correction).
+  const ResidualSeries rs = residual_series(nominal_model, d, o.locate_horizon_s, o.replay);
+  res.mismatch = locate(d, rs, train);
+
+  // 2. Name.
+  res.selection = select_effects(d, nominal, train, held, o.selection, o.replay);
+  const CorrectedSingleTrack corrected(nominal, res.selection.final_effects);
+
+  // 4. Show (held out): one-step, then the multi-step horizons.
+  std::vector<double> hs = {d.dt_s};
+  hs.insert(hs.end(), o.horizons_s.begin(), o.horizons_s.end());
+  res.before = horizon_metrics(nominal_model, d, held, hs, 5, o.replay);
+  res.after = horizon_metrics(corrected, d, held, hs, 5, o.replay);
+  const HorizonMetrics* hb = at_horizon(res.before, o.headline_horizon_s);
+  const HorizonMetrics* ha = at_horizon(res.after, o.headline_horizon_s);
+  if (hb && ha) {
+    res.headline_before = hb->normalized_rmse;
+    res.headline_after = ha->normalized_rmse;
+    res.heldout_rmse_reduction = hb->normalized_rmse > 0 ? 1.0 - ha->normalized_rmse / hb->normalized_rmse : 0.0;
+  }
+
+  // 3. Model file.
+  CorrectedModelFile file;
+  file.nominal = nominal;
+  file.effects = res.selection.final_effects;
+  file.selected = res.selection.selected;
+  // The controller has no clock of the recording: a grip change is written as the grip after it.
+  if (file.effects.grip_change_time_s > 0 && file.effects.grip_scale != 1.0) {
+    file.effects.grip_change_time_s = 0.0;
+  }
+  if (!o.out_dir.empty()) {
+    std::filesystem::create_directories(o.out_dir);
+    res.model_file = o.out_dir + "/corrected_model.yaml";
+    std::ofstream mf(res.model_file);
+    if (!mf) throw Error("cannot write " + res.model_file);
+    mf << corrected_model_to_yaml(file, "corrected model written by mppi-fit diagnose from " + d.source +
+                                            "\nload with: mppi-sim --model corrected --model-params <this file>");
+  }
+
+  // JSON.
+  json j;
+  j["log"] = d.source;
+  j["model"] = o.model_name;
+  j["params"] = o.params_source;
+  j["rows"] = d.rows();
+  j["dt_s"] = d.dt_s;
+  j["holdout"] = o.holdout;
+  j["selected"] = res.selection.selected;
+  json effects = json::array();
+  for (const auto& c : res.selection.candidates) {
+    json e;
+    e["id"] = c.id;
+    json ps;
+    for (const auto& p : c.params) ps[p.name] = {{"value", num(p.value)}, {"stddev", num(p.stddev)}, {"unit", p.unit}};
+    e["params"] = ps;
+    e["validation_improvement"] = num(c.val_improvement);
+    e["bic_delta"] = num(c.bic_delta);
+    e["heldout_improvement"] = num(c.heldout_improvement);
+    e["selected"] = c.selected;
+    if (c.selected) e["round"] = c.round_selected;
+    effects.push_back(e);
+  }
+  j["effects"] = effects;
+  json fp;
+  for (const auto& p : res.selection.final_params)
+    fp[p.name] = {{"value", num(p.value)}, {"stddev", num(p.stddev)}, {"unit", p.unit}};
+  j["final_params"] = fp;
+  json mm = json::array();
+  for (const auto& m : res.mismatch)
+    mm.push_back({{"channel", m.channel}, {"where", m.where}, {"magnitude", num(m.magnitude)},
+                  {"rms", num(m.rms)}, {"z", num(m.z)}, {"unit", m.unit}});
+  j["mismatch"] = mm;
+  auto fit_map = [&](const std::vector<HorizonMetrics>& ms) {
+    json f;
+    for (const auto& m : ms) {
+      char key[32];
+      std::snprintf(key, sizeof key, "%s", std::abs(m.horizon_s - d.dt_s) < 1e-9 ? "one_step" : "");
+      std::string k = key[0] ? key : (std::to_string(m.horizon_s).substr(0, 4) + "s");
+      for (int c = 0; c < kChannels; ++c) f[k][kChannelNames[c]] = num(m.fit_percent[c]);
+    }
+    return f;
+  };
+  auto rmse_map = [&](const std::vector<HorizonMetrics>& ms) {
+    json f;
+    for (const auto& m : ms) {
+      std::string k = std::abs(m.horizon_s - d.dt_s) < 1e-9 ? "one_step" : (std::to_string(m.horizon_s).substr(0, 4) + "s");
+      for (int c = 0; c < kChannels; ++c) f[k][kChannelNames[c]] = num(m.rmse[c]);
+      f[k]["normalized"] = num(m.normalized_rmse);
+    }
+    return f;
+  };
+  j["fit_before"] = fit_map(res.before);
+  j["fit_after"] = fit_map(res.after);
+  j["heldout_rmse_before"] = rmse_map(res.before);
+  j["heldout_rmse_after"] = rmse_map(res.after);
+  j["headline"] = {{"horizon_s", o.headline_horizon_s},
+                   {"normalized_rmse_before", num(res.headline_before)},
+                   {"normalized_rmse_after", num(res.headline_after)},
+                   {"reduction", num(res.heldout_rmse_reduction)}};
+  j["metrics_before"] = metrics_json(res.before);
+  j["metrics_after"] = metrics_json(res.after);
+  j["selection_log"] = res.selection.log;
+  j["model_file"] = res.model_file;
+  res.json = j.dump(2);
+
+  if (!o.out_dir.empty()) {
+    std::ofstream(o.out_dir + "/report.json") << res.json << "\n";
+    // Markdown.
+    std::ostringstream md;
+    md.precision(4);
+    md << "# Sim-vs-real diagnosis\n\n"
+       << "- recording: `" << d.source << "` (" << d.rows() << " rows, dt " << d.dt_s << " s), held out: `" << o.holdout
+       << "`\n- nominal model: " << o.model_name << (o.params_source.empty() ? " (library defaults)" : " from `" + o.params_source + "`")
+       << "\n- corrected model: `" << res.model_file << "`\n\n## Named effects\n\n";
+    if (res.selection.selected.empty()) md << "None: no candidate improved the validation error enough (the nominal model stands).\n";
+    for (const auto& id : res.selection.selected) md << "- **" << id << "**: " << effect_spec(id).description << "\n";
+    md << "\nFinal parameters (joint refit, 1-sigma):\n\n| parameter | value | stddev | unit |\n|---|---|---|---|\n";
+    for (const auto& p : res.selection.final_params)
+      md << "| " << p.name << " | " << p.value << " | " << p.stddev << " | " << p.unit << " |\n";
+    md << "\n## Where the nominal model is wrong (training part, " << rs.horizon_s
+       << " s predictions, acceleration error)\n\n| channel | where | mean | rms | z |\n|---|---|---|---|---|\n";
+    for (std::size_t i = 0; i < res.mismatch.size() && i < 25; ++i) {
+      const auto& m = res.mismatch[i];
+      md << "| " << m.channel << " | " << m.where << " | " << m.magnitude << " " << m.unit << " | " << m.rms << " | " << m.z << " |\n";
+    }
+    md << "\n## Candidates (each alone on the nominal model)\n\n| effect | params | validation improvement | dBIC | held-out improvement | selected |\n|---|---|---|---|---|---|\n";
+    for (const auto& c : res.selection.candidates) {
+      md << "| " << c.id << " | ";
+      for (const auto& p : c.params) md << p.name << " = " << p.value << " +- " << p.stddev << "; ";
+      md << " | " << 100 * c.val_improvement << " % | " << c.bic_delta << " | " << 100 * c.heldout_improvement << " % | "
+         << (c.selected ? "yes" : "") << " |\n";
+    }
+    md << "\n## Held-out fit before -> after\n\n| horizon | channel | fit % before | fit % after | RMSE before | RMSE after |\n|---|---|---|---|---|---|\n";
+    for (std::size_t i = 0; i < res.before.size(); ++i)
+      for (int c = 0; c < kChannels; ++c)
+        md << "| " << res.before[i].horizon_s << " s | " << kChannelNames[c] << " | " << res.before[i].fit_percent[c] << " | "
+           << res.after[i].fit_percent[c] << " | " << res.before[i].rmse[c] << " | " << res.after[i].rmse[c] << " " << kChannelUnits[c] << " |\n";
+    md << "\nHeadline: normalised multi-step RMSE at " << o.headline_horizon_s << " s: " << res.headline_before << " -> "
+       << res.headline_after << " (" << 100 * res.heldout_rmse_reduction << " % reduction).\n\n"
+       << "![residual vs regime](residual_vs_regime.png)\n\n![overlay](overlay.png)\n\n## Selection log\n\n```\n";
+    for (const auto& l : res.selection.log) md << l << "\n";
+    md << "```\n";
+    std::ofstream(o.out_dir + "/report.md") << md.str();
+    if (o.plots) {
+      const ResidualSeries rs_after = residual_series(corrected, d, o.locate_horizon_s, o.replay);
+      plot_residual_vs_regime(o.out_dir + "/residual_vs_regime.png", d, rs, rs_after, held);
+      plot_overlay(o.out_dir + "/overlay.png", d, nominal_model, corrected, held, o.replay);
+    }
+  }
+  return res;
+}
+
+}  // namespace mppi::diagnose

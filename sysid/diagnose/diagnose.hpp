@@ -1,0 +1,45 @@
+#pragma once
+// `mppi-fit diagnose` as a library call: locate the mismatch between a recording and a nominal
+// model, name the missing physics, write the corrected model, show the held-out fit before and
+// after (report.json, report.md, residual_vs_regime.png, overlay.png, corrected_model.yaml).
+#include <string>
+#include <vector>
+
+#include "dynamics/corrected_single_track.hpp"
+#include "sysid/diagnose/data.hpp"
+#include "sysid/diagnose/fit.hpp"
+#include "sysid/diagnose/locate.hpp"
+#include "sysid/diagnose/replay.hpp"
+
+namespace mppi::diagnose {
+
+struct DiagnoseOptions {
+  std::string holdout = "0.3";          // held-out fraction at the end, or a time range T0:T1 [s]
+  std::string out_dir;                  // where the report goes; empty = no files
+  double locate_horizon_s = 0.2;        // horizon of the locating residuals [s]
+  std::vector<double> horizons_s = {0.2, 0.5, 1.0, 2.0};  // multi-step horizons reported [s]
+  double headline_horizon_s = 1.0;      // the multi-step RMSE the summary quotes [s]
+  SelectionOptions selection;
+  ReplayOptions replay;
+  bool plots = true;
+  std::string model_name = "single-track";  // for the report
+  std::string params_source;            // nominal parameter file, for the report
+};
+
+struct DiagnoseResult {
+  std::vector<Mismatch> mismatch;
+  Selection selection;
+  std::vector<HorizonMetrics> before, after;  // held out: one-step first, then options.horizons_s
+  double headline_before = 0, headline_after = 0;  // normalised RMSE at the headline horizon
+  double heldout_rmse_reduction = 0;          // 1 - after / before at the headline horizon
+  std::string model_file;
+  std::string json;                           // report.json text
+};
+
+DiagnoseResult run_diagnosis(const DiagData& d, const SingleTrackParams& nominal, const DiagnoseOptions& o);
+
+// The nominal parameters from a file: a single-track parameter YAML, or a corrected-model file
+// (its nominal part; its effects are ignored). Empty path = the library defaults.
+SingleTrackParams load_nominal(const std::string& path);
+
+}  // namespace mppi::diagnose

@@ -1,0 +1,25 @@
+#pragma once
+// The report's PNG plots (OpenCV): residual vs regime before/after, and a held-out trajectory
+// overlay (measured vs nominal vs corrected open-loop predictions).
+#include <string>
+#include <vector>
+
+#include "dynamics/corrected_single_track.hpp"
+#include "sysid/diagnose/data.hpp"
+#include "sysid/diagnose/locate.hpp"
+#include "sysid/diagnose/replay.hpp"
+
+namespace mppi::diagnose {
+
+// Grid: rows = channels, columns = speed, steer, throttle, lateral accel; per panel the mean
+// residual per regime bin before (red) and after (blue), on rows in mask (held out).
+void plot_residual_vs_regime(const std::string& png, const DiagData& d, const ResidualSeries& before,
+                             const ResidualSeries& after, const std::vector<char>& mask);
+
+// Top: x-y of the held-out part with 2-s open-loop predictions every 1 s (nominal red,
+// corrected blue, measured black); below: vx and yaw rate against time with the 1-s-ahead
+// predictions.
+void plot_overlay(const std::string& png, const DiagData& d, const CorrectedSingleTrack& nominal,
+                  const CorrectedSingleTrack& corrected, const std::vector<char>& mask, const ReplayOptions& o);
+
+}  // namespace mppi::diagnose

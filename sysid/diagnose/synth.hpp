@@ -1,0 +1,59 @@
+#pragma once
+// The concealed-effect generator: a truth plant = nominal single-track + hidden effects
+// (CorrectedSingleTrack), driven around a track in closed loop by MPPI that uses the NOMINAL
+// model (sim::run_closed_loop), logged at 50 Hz with realistic sensor noise added. The
+// diagnosis tool later gets only the recording and the nominal model.
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "dynamics/corrected_single_track.hpp"
+#include "sim/recording.hpp"
+
+namespace mppi::diagnose {
+
+struct SensorNoise {
+  double position_m = 0.02;     // x, y (GPS/mocap-grade state estimate)
+  double yaw_rad = 0.005;
+  double vx_mps = 0.05;
+  double vy_mps = 0.03;
+  double yaw_rate_radps = 0.02; // gyro
+  double scale = 1.0;           // multiplies all of the above (0 = noise-free)
+};
+
+struct SynthOptions {
+  EffectParams truth;                 // hidden effects (defaults = none)
+  std::vector<std::string> truth_ids; // their ids, written to the metadata
+  std::uint64_t seed = 1;             // MPPI and noise seed
+  double duration_s = 60.0;           // recording length [s]
+  double target_speed_mps = 8.0;
+  std::string track = "gazebo";
+  int samples = 256;                  // MPPI K (small: the generator runs many recordings)
+  int horizon = 50;                   // MPPI T
+  int threads = 0;
+  SensorNoise noise;
+  std::string work_dir;               // scratch folder (truth file, raw log); required
+};
+
+// Writes the recording to `csv_path`. Returns the number of crashes during the run.
+int synthesize(const SynthOptions& o, const std::string& csv_path);
+
+// A fast open-loop variant for tests: the truth plant (500 Hz, no slew limits) driven on open
+// ground by random steering and throttle (held 0.1-0.5 s, speed kept in about 3-9 m/s), logged at
+// 50 Hz with sensor noise, in the recording format (metadata source "mppi-fit synth").
+sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t seed, double duration_s,
+                                    const SensorNoise& noise = {});
+
+// Parses "key=value,key=value" (EffectParams field names, as in the corrected-model file) into
+// `e`; returns the effect ids the keys belong to. Throws mppi::Error for an unknown key.
+std::vector<std::string> parse_effect_assignments(const std::string& text, EffectParams* e);
+
+// The sweep's truth cases: per effect id, (small, large) sizes as key=value text.
+struct SweepCase {
+  std::string id;
+  std::string small, large;
+};
+const std::vector<SweepCase>& sweep_cases();
+
+}  // namespace mppi::diagnose

@@ -1,0 +1,110 @@
+#pragma once
+// Vehicle parameter estimation from a recording: the single-track and full-vehicle models as
+// joint-state UKF / ALM-UKF process models, the estimation run (parameter convergence over
+// time), and open-loop validation on held-out data. Used by `mppi-fit estimate`
+// (docs/ESTIMATION.md).
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "dynamics/vehicle_params.hpp"
+#include "sim/recording.hpp"
+#include "sysid/alm_ukf.hpp"
+
+namespace mppi::sysid {
+
+// A vehicle model prepared for estimation: states, which recording columns measure which
+// state, the parameters that may be estimated (YAML key names, e.g. "mass_kg", "tyre.B",
+// "front_damper_Nspm"), and a double-precision step with chosen parameter values.
+struct VehicleModelSpec {
+  std::string kind;                       // "single-track" | "double-track" | "full-vehicle"
+  int nx = 0;
+  std::vector<std::string> state_names;
+  std::vector<std::pair<std::string, int>> measurable;  // recording column -> state index
+  std::vector<std::string> estimated;     // parameter names, in the order of the values
+  std::vector<double> nominal;            // their values in the base parameters
+  std::vector<bool> log_scale;            // estimated as log(value) (positive parameters)
+  double max_substep_s = 0.002;           // integration step inside one sample interval
+  // x <- x after dt with the estimated parameters set to `values` (others from the base).
+  std::function<void(const std::vector<double>& values, double* x, const double* u, double dt)> step;
+  // A full state from a recording row (unmeasured states from the measured ones).
+  std::function<void(const sim::Recording& rec, std::size_t row, double* x)> init_state;
+  // The base parameters with `values` set, as a YAML file the simulator/controller loads.
+  std::function<std::string(const std::vector<double>& values)> to_yaml;
+  // Per-state process-noise standard deviation per second (scaled by sqrt(dt)).
+  std::vector<double> process_std_per_sqrt_s;
+};
+
+// The parameter names each model accepts (for --help and error messages).
+std::vector<std::string> single_track_param_names();
+std::vector<std::string> full_vehicle_param_names();
+std::vector<std::string> double_track_param_names();
+
+// Throws mppi::Error naming an unknown parameter and listing the known ones.
+// keep_wheelbase: estimating cg_to_front_axle_m moves the CG (l_r = wheelbase - l_f).
+VehicleModelSpec single_track_spec(const SingleTrackParams& base, const std::vector<std::string>& estimated,
+                                   bool keep_wheelbase = false);
+VehicleModelSpec double_track_spec(const DoubleTrackParams& base, const std::vector<std::string>& estimated,
+                                   bool keep_wheelbase = false);
+VehicleModelSpec full_vehicle_spec(const FullVehicleParams& base, const std::vector<std::string>& estimated,
+                                   bool keep_wheelbase = false);
+
+struct EstimateSettings {
+  bool adaptive = true;                  // ALM-UKF (else the standard joint-state UKF)
+  UkfSettings ukf;
+  double alm_window_s = 10.0;            // the paper: noise samples from the last 10 s
+  bool alm_process = false;              // also re-estimate q, Q (see docs: Q with R drifts)
+  bool alm_measurement = true;           // re-estimate r, R
+  std::vector<std::string> measure;      // recording columns used (empty = all the model can use)
+  std::vector<std::pair<std::string, double>> measurement_std;  // overrides of the defaults
+  double param_initial_std = 0.3;        // log-scale: sd of log(p); linear: sd (abs) = this
+  double param_walk_std_per_s = 0.003;   // random-walk sd per sqrt(s), same units (rescaled Q^p)
+  double process_noise_scale = 1.0;      // multiplies the model's per-state process noise
+  double t_begin_s = -1e300;             // fit on rows with t in [t_begin_s, t_end_s)
+  double t_end_s = 1e300;
+  int record_every = 5;                  // keep every n-th step in the history (plots, CSV)
+
+  bool is_valid(std::string* why) const;
+};
+
+struct EstimateResult {
+  std::vector<std::string> names;
+  std::vector<double> initial, final_values, final_std;  // physical units (std: delta method)
+  std::vector<double> t;                                 // history times
+  std::vector<std::vector<double>> history;              // [k][param]
+  std::vector<std::vector<double>> history_std;
+  std::vector<std::string> measured;                     // columns used
+  std::vector<double> innovation_rms;                    // per measured column, over the fit
+  std::vector<double> measurement_std;                   // final sqrt(diag R) (ALM: estimated)
+  int steps = 0;
+  int projections = 0;
+  int rejected_steps = 0;  // steps undone because the state went non-finite
+  double wall_s = 0;
+};
+
+// Runs the joint-state filter over the fit rows. Throws mppi::Error for a recording that
+// lacks a required column, or has too few rows.
+EstimateResult estimate_parameters(const VehicleModelSpec& spec, const sim::Recording& rec,
+                                   const EstimateSettings& settings,
+                                   const std::vector<double>& initial_values = {});
+
+// The time after which a parameter's estimate stays within `band` (relative) of its final
+// value (the paper's "converges within 20 s"); t of the first sample if always inside.
+double convergence_time(const EstimateResult& r, std::size_t param, double band);
+
+struct ValidationResult {
+  std::vector<std::string> channels;     // x, y, yaw, vx, vy, yaw_rate
+  std::vector<double> open_loop_rms;     // whole segment open loop from its first state
+  std::vector<double> horizon_rms;       // rollouts of horizon_s restarted every horizon_s
+  std::vector<double> t;                 // open-loop trajectory (for plots)
+  std::vector<std::vector<double>> simulated;  // [channel][k]
+  std::vector<std::vector<double>> measured;   // [channel][k]
+};
+
+// Simulates the model with `values` over rows [begin, end) of `rec` with the recorded
+// controls, open loop from the measured state of the first row, and in horizon_s chunks.
+ValidationResult validate_parameters(const VehicleModelSpec& spec, const std::vector<double>& values,
+                                     const sim::Recording& rec, std::size_t begin, std::size_t end,
+                                     double horizon_s = 1.0);
+
+}  // namespace mppi::sysid
