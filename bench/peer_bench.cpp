@@ -7,12 +7,16 @@
 //                                  own: counters mean_ms, median_ms, p99_ms, max_ms (wall clock);
 //                                  the reported time is the mean (manual time).
 //   BM_PeerNoise/K/T/threads       drawing the K x T x 2 clamped perturbed controls only
+//   BM_PeerPhilox/K/T/threads      the Philox4x32-10 words of that noise only (one call per
+//                                  sample and time step: 2 controls use 2 of its 4 words)
+//   BM_PeerNormals/K/T/threads     Philox + Box-Muller (the normals, not yet clamped / stored)
 //   BM_PeerRollout/K/T/threads     backend rollout with the cost (no sampling, no update)
 //   BM_PeerDynamics/K/T/threads    backend rollout, model only (cost = 0)
 //   BM_AutoRallyScaling/K/T/threads  BM_PeerIteration's timing for the AutoRally network +
 //                                  AutoRallyCost on the Gazebo map (open loop, fixed state)
 // scripts/peer_compare.py prints BM_PeerIteration beside the published figures.
 #include <benchmark/benchmark.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <chrono>
@@ -25,6 +29,8 @@
 #include "dynamics/autorally_nn.hpp"
 #include "mppi/controller.hpp"
 #include "mppi/cpu_backend.hpp"
+#include "mppi/multiversion.hpp"
+#include "mppi/noise.hpp"
 #include "peer_workload.hpp"
 
 namespace {
@@ -134,6 +140,45 @@ void BM_PeerNoise(benchmark::State& state) {
   set_shape_counters(state, k, horizon, threads);
 }
 
+// The noise kernel's stages for one chunk of kChunk samples and every t. Multiversioned like
+// sample_chunk, so that Box-Muller gets the same vector width as in the controller.
+template <bool kBoxMuller>
+MPPI_MULTIVERSION float noise_stage_chunk(std::uint32_t iteration, int chunk, int horizon) noexcept {
+  alignas(64) std::uint32_t words[4 * mppi::kChunk];
+  alignas(64) float normals[4 * mppi::kChunk];
+  float acc = 0.f;
+  for (int t = 0; t < horizon; ++t) {
+    if constexpr (kBoxMuller) {
+      mppi::normal_block<mppi::kChunk>(mppi::NoiseKey{1}, iteration, static_cast<std::uint32_t>(chunk * mppi::kChunk),
+                                       static_cast<std::uint32_t>(t), 0u, normals, 1);
+      acc += normals[t % mppi::kChunk];
+    } else {
+      mppi::detail::philox_words_dispatch<mppi::kChunk>(1u, 0u, iteration, static_cast<std::uint32_t>(chunk * mppi::kChunk),
+                                                        static_cast<std::uint32_t>(t), 0u, words);
+      acc += static_cast<float>(words[t % mppi::kChunk]);
+    }
+  }
+  return acc;
+}
+
+template <bool kBoxMuller>
+void noise_stage(benchmark::State& state) {
+  const int k = static_cast<int>(state.range(0)), horizon = static_cast<int>(state.range(1)),
+            threads = static_cast<int>(state.range(2));
+  const int chunks = mppi::padded_sample_count(k) / mppi::kChunk;
+  std::uint32_t iteration = 0;
+  std::vector<float> sink(static_cast<std::size_t>(chunks), 0.f);
+  for (auto _ : state) {
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int c = 0; c < chunks; ++c) sink[c] += noise_stage_chunk<kBoxMuller>(iteration, c, horizon);
+    ++iteration;
+    benchmark::DoNotOptimize(sink.data());
+  }
+  set_shape_counters(state, k, horizon, threads);
+}
+void BM_PeerPhilox(benchmark::State& state) { noise_stage<false>(state); }
+void BM_PeerNormals(benchmark::State& state) { noise_stage<true>(state); }
+
 template <class Cost>
 void peer_rollout(benchmark::State& state, Cost cost) {
   const int k = static_cast<int>(state.range(0)), horizon = static_cast<int>(state.range(1)),
@@ -223,6 +268,8 @@ void autorally_args(benchmark::internal::Benchmark* b) {
 
 BENCHMARK(BM_PeerIteration)->Apply(peer_k_args);
 BENCHMARK(BM_PeerNoise)->Apply(peer_part_args);
+BENCHMARK(BM_PeerPhilox)->Apply(peer_part_args);
+BENCHMARK(BM_PeerNormals)->Apply(peer_part_args);
 BENCHMARK(BM_PeerRollout)->Apply(peer_part_args);
 BENCHMARK(BM_PeerDynamics)->Apply(peer_part_args);
 BENCHMARK(BM_AutoRallyScaling)->Apply(autorally_args);
