@@ -120,20 +120,20 @@ def test_diff_drive_controller_drives_to_the_goal():
     robot = mppi.DiffDrive()
     x = np.array([1.0, 1.0, 0.0], np.float32)
     start = math.hypot(9, 9)
-    for _ in range(1500):  # 30 s
+    for _ in range(750):  # 15 s
         u, s = c.step(x)
         assert s.status == mppi.StepStatus.OK
         assert u.dtype == np.float32 and u.shape == (2,)
         assert -0.35 <= u[0] <= 0.5 and -0.5 <= u[1] <= 0.5
         x = robot.step(x, u, 0.02)
     # the benchmark's goal-angle term (goal yaw 0) keeps the heading near 0, so the robot runs
-    # along x first; in 30 s it must still have closed on the goal (10, 10) by > 2 m
-    assert math.hypot(10 - x[0], 10 - x[1]) < start - 2.0
+    # along x first; in 15 s it must still have closed on the goal (10, 10) by > 1 m
+    assert math.hypot(10 - x[0], 10 - x[1]) < start - 1.0
     assert abs(x[2]) < 0.5
     assert c.nominal.shape == (100, 2)
     w = c.weights
     assert w.shape == (1024,) and abs(w.sum() - 1) < 1e-4
-    assert c.step_index == 1500
+    assert c.step_index == 750
 
 
 def test_same_seed_same_controls_and_errors():
