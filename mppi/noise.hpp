@@ -4,7 +4,9 @@
 // so every draw depends only on its own indices: the same numbers whatever the thread count,
 // and the same on the GPU. Each Philox call gives 4 words -> 2 Box-Muller pairs -> the normals
 // of 4 consecutive channels. Written lane-wise so a batch of samples vectorises; tests check it
-// against Random123's own philox4x32 and the normal distribution.
+// against Random123's own philox4x32 and the normal distribution. On x86-64 the Philox words
+// come from AVX-512 / AVX2 code when the CPU has it (the very same words, see
+// detail::philox_words_dispatch).
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -90,8 +92,9 @@ inline void philox_words(std::uint32_t k0, std::uint32_t k1, std::uint32_t itera
 #pragma GCC diagnostic ignored "-Wuninitialized"
 // The auto-vectorised loop above widens every 32 x 32 -> 64-bit product to 64-bit lanes; these
 // keep 32-bit lanes (mullo for the low words, two vpmuludq + a shuffle/blend for the high
-// words): the AVX-512 one is 2.2x faster per word than the auto-vectorised loop on Zen 4. Chosen at run time (philox_words_dispatch), so the library still
-// runs on any x86-64.
+// words). The AVX-512 one is 2.2x faster per word than the auto-vectorised loop on Zen 4. The
+// path is chosen at run time (philox_words_dispatch), so the library still runs on any x86-64.
+
 // One Philox round on 16 lanes. High words: vpmuludq on the even lanes and on the odd lanes
 // shuffled down, the even products' high halves shuffled back into place under a mask.
 struct Philox16 {
