@@ -58,7 +58,7 @@ MPPI_MULTIVERSION inline void sample_chunk(const NoiseKey& key, std::uint32_t it
   for (int t = 0; t < horizon; ++t) {
     for (int block = 0; block * 4 < nu; ++block) {
       normal_block<W>(key, iteration, static_cast<std::uint32_t>(k0), static_cast<std::uint32_t>(t),
-                      static_cast<std::uint32_t>(block), normals);
+                      static_cast<std::uint32_t>(block), normals, nu - block * 4 > 2 ? 2 : 1);
       for (int c = block * 4; c < std::min(nu, block * 4 + 4); ++c) {
         const float u = nominal[t * nu + c];
         const float sd = noise_std[c];

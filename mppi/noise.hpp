@@ -4,9 +4,16 @@
 // so every draw depends only on its own indices: the same numbers whatever the thread count,
 // and the same on the GPU. Each Philox call gives 4 words -> 2 Box-Muller pairs -> the normals
 // of 4 consecutive channels. Written lane-wise so a batch of samples vectorises; tests check it
-// against Random123's own philox4x32 and the normal distribution.
+// against Random123's own philox4x32 and the normal distribution. On x86-64 the Philox words
+// come from AVX-512 / AVX2 code when the CPU has it (the very same words, see
+// detail::philox_words_dispatch).
 #include <cmath>
 #include <cstdint>
+#include <utility>
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#endif
 
 #include "mppi/batch.hpp"
 #include "mppi/fast_math.hpp"
@@ -58,20 +65,163 @@ inline void box_muller(std::uint32_t a, std::uint32_t b, float* n0, float* n1) n
   *n1 = r * s;
 }
 
-// Standard normals for W consecutive samples starting at `first_sample`, at time step t and
-// iteration `iteration`, channels [4*block, 4*block + 4): out[ch * W + lane], ch < 4.
+namespace detail {
+// Philox4x32-10 of the counters (first + j, t, iteration, block), j in [0, W), key (k0, k1):
+// word w of lane j -> words[w * W + j]. Portable lane loop; the SIMD versions below give the
+// same words (integer arithmetic, exact).
 template <int W>
-inline void normal_block(const NoiseKey& key, std::uint32_t iteration, std::uint32_t first_sample,
-                         std::uint32_t t, std::uint32_t block, float* out) noexcept {
-  const auto k0 = static_cast<std::uint32_t>(key.seed);
-  const auto k1 = static_cast<std::uint32_t>(key.seed >> 32);
+inline void philox_words(std::uint32_t k0, std::uint32_t k1, std::uint32_t iteration,
+                         std::uint32_t first, std::uint32_t t, std::uint32_t block,
+                         std::uint32_t* words) noexcept {
   MPPI_SIMD_LOOP
   for (int j = 0; j < W; ++j) {
-    std::uint32_t c0 = first_sample + static_cast<std::uint32_t>(j), c1 = t, c2 = iteration,
-                  c3 = block;
+    std::uint32_t c0 = first + static_cast<std::uint32_t>(j), c1 = t, c2 = iteration, c3 = block;
     philox4x32_10(c0, c1, c2, c3, k0, k1);
-    box_muller(c0, c1, &out[0 * W + j], &out[1 * W + j]);
-    box_muller(c2, c3, &out[2 * W + j], &out[3 * W + j]);
+    words[0 * W + j] = c0;
+    words[1 * W + j] = c1;
+    words[2 * W + j] = c2;
+    words[3 * W + j] = c3;
+  }
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(MPPI_NO_SIMD_PHILOX)
+#define MPPI_SIMD_PHILOX 1
+// GCC 12's own avx512fintrin.h trips -Wmaybe-uninitialized (its _mm512_undefined_* helpers).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wuninitialized"
+// The auto-vectorised loop above widens every 32 x 32 -> 64-bit product to 64-bit lanes; these
+// keep 32-bit lanes (mullo for the low words, two vpmuludq + a shuffle/blend for the high
+// words). The AVX-512 one is 2.2x faster per word than the auto-vectorised loop on Zen 4. The
+// path is chosen at run time (philox_words_dispatch), so the library still runs on any x86-64.
+
+// One Philox round on 16 lanes. High words: vpmuludq on the even lanes and on the odd lanes
+// shuffled down, the even products' high halves shuffled back into place under a mask.
+struct Philox16 {
+  __m512i c0, c1, c2, c3;
+};
+__attribute__((target("avx512f"), always_inline)) inline void philox_round16(
+    Philox16& p, __m512i m0, __m512i m1, __m512i ka, __m512i kb) noexcept {
+  const __m512i even0 = _mm512_mul_epu32(p.c0, m0);
+  const __m512i odd0 = _mm512_mul_epu32(_mm512_shuffle_epi32(p.c0, _MM_PERM_DDBB), m0);
+  const __m512i even1 = _mm512_mul_epu32(p.c2, m1);
+  const __m512i odd1 = _mm512_mul_epu32(_mm512_shuffle_epi32(p.c2, _MM_PERM_DDBB), m1);
+  const __m512i hi0 = _mm512_mask_shuffle_epi32(odd0, 0x5555, even0, _MM_PERM_DDBB);
+  const __m512i hi1 = _mm512_mask_shuffle_epi32(odd1, 0x5555, even1, _MM_PERM_DDBB);
+  const __m512i lo0 = _mm512_mullo_epi32(p.c0, m0);
+  const __m512i lo1 = _mm512_mullo_epi32(p.c2, m1);
+  p.c0 = _mm512_ternarylogic_epi32(hi1, p.c1, ka, 0x96);  // hi1 ^ c1 ^ k0
+  p.c2 = _mm512_ternarylogic_epi32(hi0, p.c3, kb, 0x96);  // hi0 ^ c3 ^ k1
+  p.c1 = lo1;
+  p.c3 = lo0;
+}
+
+// lanes: a multiple of 32 (two independent 16-lane streams interleaved to hide the latency).
+__attribute__((target("avx512f"))) inline void philox_words_avx512(
+    std::uint32_t k0, std::uint32_t k1, std::uint32_t iteration, std::uint32_t first,
+    std::uint32_t t, std::uint32_t block, int lanes, std::uint32_t* words) noexcept {
+  const __m512i m0 = _mm512_set1_epi32(static_cast<int>(kPhiloxM0));
+  const __m512i m1 = _mm512_set1_epi32(static_cast<int>(kPhiloxM1));
+  const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  const __m512i c1 = _mm512_set1_epi32(static_cast<int>(t));
+  const __m512i c2 = _mm512_set1_epi32(static_cast<int>(iteration));
+  const __m512i c3 = _mm512_set1_epi32(static_cast<int>(block));
+  for (int v = 0; v < lanes; v += 32) {
+    Philox16 a{_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v))), lane), c1, c2, c3};
+    Philox16 b{_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v + 16))), lane), c1, c2, c3};
+    std::uint32_t ka = k0, kb = k1;
+    for (int r = 0; r < 10; ++r) {
+      const __m512i bka = _mm512_set1_epi32(static_cast<int>(ka));
+      const __m512i bkb = _mm512_set1_epi32(static_cast<int>(kb));
+      philox_round16(a, m0, m1, bka, bkb);
+      philox_round16(b, m0, m1, bka, bkb);
+      ka += kPhiloxW0;
+      kb += kPhiloxW1;
+    }
+    for (const auto& [p, off] : {std::pair<const Philox16&, int>{a, v}, {b, v + 16}}) {
+      _mm512_storeu_si512(words + 0 * lanes + off, p.c0);
+      _mm512_storeu_si512(words + 1 * lanes + off, p.c1);
+      _mm512_storeu_si512(words + 2 * lanes + off, p.c2);
+      _mm512_storeu_si512(words + 3 * lanes + off, p.c3);
+    }
+  }
+}
+
+// lanes: a multiple of 8.
+__attribute__((target("avx2"))) inline void philox_words_avx2(
+    std::uint32_t k0, std::uint32_t k1, std::uint32_t iteration, std::uint32_t first,
+    std::uint32_t t, std::uint32_t block, int lanes, std::uint32_t* words) noexcept {
+  const __m256i m0 = _mm256_set1_epi32(static_cast<int>(kPhiloxM0));
+  const __m256i m1 = _mm256_set1_epi32(static_cast<int>(kPhiloxM1));
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  for (int v = 0; v < lanes; v += 8) {
+    __m256i c0 = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v))), lane);
+    __m256i c1 = _mm256_set1_epi32(static_cast<int>(t));
+    __m256i c2 = _mm256_set1_epi32(static_cast<int>(iteration));
+    __m256i c3 = _mm256_set1_epi32(static_cast<int>(block));
+    std::uint32_t ka = k0, kb = k1;
+    for (int r = 0; r < 10; ++r) {
+      const __m256i lo0 = _mm256_mullo_epi32(c0, m0);
+      const __m256i hi0 = _mm256_blend_epi32(_mm256_srli_epi64(_mm256_mul_epu32(c0, m0), 32),
+                                             _mm256_mul_epu32(_mm256_srli_epi64(c0, 32), m0), 0xAA);
+      const __m256i lo1 = _mm256_mullo_epi32(c2, m1);
+      const __m256i hi1 = _mm256_blend_epi32(_mm256_srli_epi64(_mm256_mul_epu32(c2, m1), 32),
+                                             _mm256_mul_epu32(_mm256_srli_epi64(c2, 32), m1), 0xAA);
+      c0 = _mm256_xor_si256(_mm256_xor_si256(hi1, c1), _mm256_set1_epi32(static_cast<int>(ka)));
+      c2 = _mm256_xor_si256(_mm256_xor_si256(hi0, c3), _mm256_set1_epi32(static_cast<int>(kb)));
+      c1 = lo1;
+      c3 = lo0;
+      ka += kPhiloxW0;
+      kb += kPhiloxW1;
+    }
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(words + 0 * lanes + v), c0);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(words + 1 * lanes + v), c1);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(words + 2 * lanes + v), c2);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(words + 3 * lanes + v), c3);
+  }
+}
+
+// 2: AVX-512F, 1: AVX2, 0: portable. Decided once per process.
+inline int philox_simd_level() noexcept {
+  static const int level = __builtin_cpu_supports("avx512f") ? 2 : __builtin_cpu_supports("avx2") ? 1 : 0;
+  return level;
+}
+#pragma GCC diagnostic pop
+#endif
+
+// philox_words<W> on the fastest path this CPU has.
+template <int W>
+inline void philox_words_dispatch(std::uint32_t k0, std::uint32_t k1, std::uint32_t iteration,
+                                  std::uint32_t first, std::uint32_t t, std::uint32_t block,
+                                  std::uint32_t* words) noexcept {
+#ifdef MPPI_SIMD_PHILOX
+  if constexpr (W % 8 == 0) {
+    const int level = philox_simd_level();
+    if (W % 32 == 0 && level == 2) return philox_words_avx512(k0, k1, iteration, first, t, block, W, words);
+    if (level >= 1) return philox_words_avx2(k0, k1, iteration, first, t, block, W, words);
+  }
+#endif
+  philox_words<W>(k0, k1, iteration, first, t, block, words);
+}
+}  // namespace detail
+
+// Standard normals for W consecutive samples starting at `first_sample`, at time step t and
+// iteration `iteration`, channels [4*block, 4*block + 2*pairs): out[ch * W + lane]. pairs = 2
+// gives all 4 channels of the block; pairs = 1 only channels 4*block and 4*block + 1 (their
+// Box-Muller pair uses words 0 and 1 only, so a model with 2 controls skips half the work).
+template <int W>
+inline void normal_block(const NoiseKey& key, std::uint32_t iteration, std::uint32_t first_sample,
+                         std::uint32_t t, std::uint32_t block, float* out, int pairs = 2) noexcept {
+  alignas(64) std::uint32_t words[4 * W];
+  detail::philox_words_dispatch<W>(static_cast<std::uint32_t>(key.seed),
+                                   static_cast<std::uint32_t>(key.seed >> 32), iteration,
+                                   first_sample, t, block, words);
+  MPPI_SIMD_LOOP
+  for (int j = 0; j < W; ++j) box_muller(words[j], words[W + j], &out[0 * W + j], &out[1 * W + j]);
+  if (pairs > 1) {
+    MPPI_SIMD_LOOP
+    for (int j = 0; j < W; ++j)
+      box_muller(words[2 * W + j], words[3 * W + j], &out[2 * W + j], &out[3 * W + j]);
   }
 }
 
