@@ -312,7 +312,17 @@ int mppi_fit_estimate(int argc, char** argv) {
     std::vector<PlotPanel> conv;
     for (std::size_t i = 0; i < np; ++i) {
       PlotPanel p;
-      p.title = res.names[i];
+      // Convergence time (5% band around the truth if known, else around the final value):
+      // in the title and as a red dashed vertical line.
+      const double tc = have_truth ? convergence_time_to(res, i, 0.05, truth[i]) : convergence_time(res, i, 0.05);
+      {
+        char b[64];
+        if (std::isfinite(tc))
+          std::snprintf(b, sizeof b, "  (5%%: %.1f s)", tc - res.t.front());
+        else
+          std::snprintf(b, sizeof b, "  (5%%: never)");
+        p.title = res.names[i] + b;
+      }
       p.x_label = "t [s]";
       PlotSeries s, lo, hi;
       for (std::size_t k = 0; k < res.t.size(); ++k) {
@@ -327,12 +337,19 @@ int mppi_fit_estimate(int argc, char** argv) {
       s.label = "estimate";
       hi.label = "+-2 sd";
       p.series = {lo, hi, s};
+      if (std::isfinite(tc)) {
+        const double y0 = *std::min_element(lo.y.begin(), lo.y.end());
+        const double y1 = *std::max_element(hi.y.begin(), hi.y.end());
+        p.series.push_back({{tc, tc}, {y0, y1}, 3, "", true});
+      }
       if (have_truth) p.hlines.push_back(truth[i]);
       conv.push_back(p);
     }
     write_panels_png(out_dir + "/convergence.png",
                      std::string(st.adaptive ? "ALM-UKF" : "joint-state UKF") + " parameter convergence" +
-                         (have_truth ? " (dashed grey: true value)" : ""), conv, 3, 380, 220);
+                         (have_truth ? " (grey dashed: true value; red: stays within 5% of it after)"
+                                     : " (red: stays within 5% of the final value after)"),
+                     conv, 3, 380, 220);
 
     // Validation: held-out window or recording, estimated vs nominal parameters.
     sim::Recording val_rec;
@@ -385,19 +402,46 @@ int mppi_fit_estimate(int argc, char** argv) {
     for (std::size_t i = 0; i < res.measured.size(); ++i)
       sum << " " << res.measured[i] << " (innovation rms " << res.innovation_rms[i] << ", noise std "
           << res.measurement_std[i] << ")";
-    sum << "\n\nparameter                    initial     estimate    2sd         truth       error%   converged(2%) s\n";
+    // Convergence time: the last exit from a band around the final estimate and, with --truth,
+    // around the true value ("never" when the estimate ends outside it); seconds from the fit start.
+    auto conv_text = [](double t) {
+      char b[16];
+      if (std::isfinite(t)) std::snprintf(b, sizeof b, "%.1f", t);
+      else std::snprintf(b, sizeof b, "never");
+      return std::string(b);
+    };
+    sum << "\n\nconvergence: time [s from the fit start] after which the estimate stays within 5% / 2% of its final\n"
+        << "value" << (have_truth ? " and of the truth" : "") << "\n";
+    sum << "parameter                    initial     estimate    2sd         truth       error%   final 5%/2%  "
+        << (have_truth ? "truth 5%/2%" : "") << "\n";
     std::ofstream pc(out_dir + "/parameters.csv");
-    pc << "name,initial,estimate,std,truth,error_pct,converged_2pct_s,converged_5pct_s\n";
+    pc << "name,initial,estimate,std,truth,error_pct,converged_2pct_s,converged_5pct_s,converged_truth_2pct_s,"
+          "converged_truth_5pct_s\n";
+    double slowest_final5 = 0, slowest_truth5 = 0;
+    std::string slowest_final5_name, slowest_truth5_name;
     for (std::size_t i = 0; i < np; ++i) {
       const double err = have_truth ? 100.0 * (res.final_values[i] - truth[i]) / truth[i] : NAN;
-      const double c2 = convergence_time(res, i, 0.02), c5 = convergence_time(res, i, 0.05);
+      const double t0 = res.t.front();
+      const double c2 = convergence_time(res, i, 0.02) - t0, c5 = convergence_time(res, i, 0.05) - t0;
+      const double ct2 = have_truth ? convergence_time_to(res, i, 0.02, truth[i]) - t0 : NAN;
+      const double ct5 = have_truth ? convergence_time_to(res, i, 0.05, truth[i]) - t0 : NAN;
+      if (c5 >= slowest_final5) slowest_final5 = c5, slowest_final5_name = res.names[i];
+      if (have_truth && !(ct5 < slowest_truth5)) slowest_truth5 = ct5, slowest_truth5_name = res.names[i];
       char line[256];
-      std::snprintf(line, sizeof line, "%-28s %-11.5g %-11.5g %-11.3g %-11.5g %-8.2f %.1f\n", res.names[i].c_str(),
-                    res.initial[i], res.final_values[i], 2 * res.final_std[i], truth[i], err, c2 - res.t.front());
+      std::snprintf(line, sizeof line, "%-28s %-11.5g %-11.5g %-11.3g %-11.5g %-8.2f %-12s %s\n", res.names[i].c_str(),
+                    res.initial[i], res.final_values[i], 2 * res.final_std[i], truth[i], err,
+                    (conv_text(c5) + " / " + conv_text(c2)).c_str(),
+                    have_truth ? (conv_text(ct5) + " / " + conv_text(ct2)).c_str() : "");
       sum << line;
       pc << res.names[i] << "," << res.initial[i] << "," << res.final_values[i] << "," << res.final_std[i] << ","
-         << truth[i] << "," << err << "," << c2 - res.t.front() << "," << c5 - res.t.front() << "\n";
+         << truth[i] << "," << err << "," << c2 << "," << c5 << "," << ct2 << "," << ct5 << "\n";
     }
+    auto seconds = [&](double t) { return std::isfinite(t) ? conv_text(t) + " s" : std::string("never"); };
+    sum << "slowest to settle within 5% of its final value: " << slowest_final5_name << " (" << seconds(slowest_final5)
+        << ")\n";
+    if (have_truth)
+      sum << "slowest to stay within 5% of the truth: " << slowest_truth5_name << " (" << seconds(slowest_truth5)
+          << ")\n";
     if (validate) {
       sum << "\nvalidation (" << ve - vb << " rows): rms error, estimated vs nominal parameters\n"
           << "channel     open-loop est   open-loop nom   " << horizon_s << "s-rollouts est   " << horizon_s

@@ -17,14 +17,18 @@ namespace {
 
 const char* kProtocolUsage = R"(usage: mppi-fit protocol [options]
 Drives the simulated full-vehicle plant (known parameters) through the paper's five manoeuvres
-(low speed, zig-zag, straight acceleration and braking, sliding, high speed; 20 s each) and a
-held-out 13 s lap-like segment, with sensor noise. Writes DIR/train.csv, DIR/validation.csv
+(low speed, zig-zag, straight acceleration and braking, sliding, high speed; 20 s of each) and a
+held-out 13 s lap-like segment, with sensor noise. By default the manoeuvres are interleaved as a
+human driver mixes them (a 20 s cycle of five 4 s pieces, repeated); --layout sequential drives
+each for its whole 20 s in turn. Writes DIR/train.csv, DIR/validation.csv
 (measured, docs/RECORDING_FORMAT.md), DIR/truth.csv (noise-free states), DIR/truth.yaml,
 DIR/protocol.png.
   --params FILE       full-vehicle parameters of the plant (default data/config/autorally_full_vehicle.yaml)
   --out DIR           output folder (default out/protocol)
   --seed N            sensor-noise seed (1)
-  --manoeuvre-s S     duration of each manoeuvre (20)
+  --manoeuvre-s S     total time in each manoeuvre (20)
+  --layout L          interleaved | sequential (interleaved)
+  --piece-s S         interleaved: duration of one manoeuvre piece (4; cycle = 5 pieces)
   --validation-s S    duration of the held-out segment (13)
   --noise-scale F     multiply every sensor-noise standard deviation by F (1; 0 = no noise)
 )";
@@ -57,6 +61,8 @@ int mppi_fit_protocol(int argc, char** argv) {
       else if (flag == "--out") out = value;
       else if (flag == "--seed") options.seed = static_cast<std::uint64_t>(number());
       else if (flag == "--manoeuvre-s") options.manoeuvre_duration_s = number();
+      else if (flag == "--layout") options.layout = mppi::sysid::parse_protocol_layout(value);
+      else if (flag == "--piece-s") options.piece_duration_s = number();
       else if (flag == "--validation-s") options.validation_duration_s = number();
       else if (flag == "--noise-scale") noise_scale = number();
       else {

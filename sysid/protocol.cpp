@@ -173,6 +173,10 @@ bool ProtocolOptions::is_valid(std::string* why) const {
   };
   if (!(manoeuvre_duration_s > 0 && std::isfinite(manoeuvre_duration_s)))
     return fail("manoeuvre_duration_s must be > 0");
+  if (!(piece_duration_s > 0 && std::isfinite(piece_duration_s)))
+    return fail("piece_duration_s must be > 0");
+  if (layout != ProtocolLayout::interleaved && layout != ProtocolLayout::sequential)
+    return fail("layout must be interleaved or sequential");
   if (!(validation_duration_s >= 0 && std::isfinite(validation_duration_s)))
     return fail("validation_duration_s must be >= 0");
   if (!(sample_rate_hz > 0 && std::isfinite(sample_rate_hz))) return fail("sample_rate_hz must be > 0");
@@ -189,6 +193,32 @@ const std::vector<std::string>& protocol_segment_names() {
   static const std::vector<std::string> names = {"low_speed", "zig_zag", "accelerate_brake",
                                                  "sliding", "high_speed", "validation"};
   return names;
+}
+
+std::string protocol_layout_name(ProtocolLayout layout) {
+  return layout == ProtocolLayout::sequential ? "sequential" : "interleaved";
+}
+
+ProtocolLayout parse_protocol_layout(const std::string& name) {
+  if (name == "interleaved") return ProtocolLayout::interleaved;
+  if (name == "sequential") return ProtocolLayout::sequential;
+  throw Error("protocol layout '" + name + "': expected interleaved or sequential");
+}
+
+ProtocolSegmentTime protocol_segment_at(const ProtocolOptions& o, double t) {
+  ProtocolSegmentTime st;
+  if (o.layout == ProtocolLayout::sequential) {
+    st.segment = std::clamp(static_cast<int>(std::floor(t / o.manoeuvre_duration_s)) + 1, 1, 5);
+    st.manoeuvre_time_s = t - (st.segment - 1) * o.manoeuvre_duration_s;
+    return st;
+  }
+  // Interleaved: cycle c, piece s in it; the manoeuvre has run c full pieces before.
+  const double cycle_s = 5 * o.piece_duration_s;
+  const double c = std::floor(t / cycle_s);
+  const double in_cycle = t - c * cycle_s;
+  st.segment = std::clamp(static_cast<int>(std::floor(in_cycle / o.piece_duration_s)) + 1, 1, 5);
+  st.manoeuvre_time_s = c * o.piece_duration_s + in_cycle - (st.segment - 1) * o.piece_duration_s;
+  return st;
 }
 
 ProtocolRun run_protocol(const FullVehicleParams& params, const ProtocolOptions& o) {
@@ -218,6 +248,9 @@ ProtocolRun run_protocol(const FullVehicleParams& params, const ProtocolOptions&
       {"segments", "1 low_speed, 2 zig_zag, 3 accelerate_brake, 4 sliding, 5 high_speed (" +
                        num(o.manoeuvre_duration_s) + " s each), 6 validation (" +
                        num(o.validation_duration_s) + " s)"},
+      {"layout", o.layout == ProtocolLayout::sequential
+                     ? std::string("sequential (each manoeuvre in turn)")
+                     : "interleaved (cycles of five " + num(o.piece_duration_s) + " s pieces, one per manoeuvre)"},
       {"noise_std", "position " + num(o.position_noise_m) + " m, yaw " + num(o.yaw_noise_rad) +
                         " rad, velocity " + num(o.velocity_noise_mps) + " m/s, rates " +
                         num(o.rate_noise_radps) + " rad/s, roll/pitch " + num(o.angle_noise_rad) +
@@ -239,8 +272,9 @@ ProtocolRun run_protocol(const FullVehicleParams& params, const ProtocolOptions&
 
   for (long k = 0; k < n_train + n_val; ++k) {
     const double t = k * sample_dt;
-    const int seg = k < n_train ? std::min(5, static_cast<int>(t / o.manoeuvre_duration_s) + 1) : 6;
-    const double tin = k < n_train ? t - (seg - 1) * o.manoeuvre_duration_s : t - n_train * sample_dt;
+    const ProtocolSegmentTime st = protocol_segment_at(o, t);
+    const int seg = k < n_train ? st.segment : 6;
+    const double tin = k < n_train ? st.manoeuvre_time_s : t - n_train * sample_dt;
     const float* xf = plant.state();
     double x[FullVehicle::kNx];
     std::copy(xf, xf + FullVehicle::kNx, x);

@@ -428,12 +428,17 @@ EstimateResult estimate_parameters(const VehicleModelSpec& spec, const sim::Reco
   return res;
 }
 
-double convergence_time(const EstimateResult& r, std::size_t param, double band) {
-  const double fin = r.final_values[param];
-  const double tol = band * std::max(std::abs(fin), 1e-9);
+double convergence_time_to(const EstimateResult& r, std::size_t param, double band, double reference) {
+  if (r.t.empty() || r.history.size() != r.t.size()) throw Error("convergence_time: empty or inconsistent history");
+  const double tol = band * std::max(std::abs(reference), 1e-9);
   for (std::size_t k = r.t.size(); k-- > 0;)
-    if (std::abs(r.history[k][param] - fin) > tol) return k + 1 < r.t.size() ? r.t[k + 1] : r.t.back();
+    if (!(std::abs(r.history[k][param] - reference) <= tol))
+      return k + 1 < r.t.size() ? r.t[k + 1] : std::numeric_limits<double>::infinity();
   return r.t.front();
+}
+
+double convergence_time(const EstimateResult& r, std::size_t param, double band) {
+  return convergence_time_to(r, param, band, r.final_values.at(param));
 }
 
 ValidationResult validate_parameters(const VehicleModelSpec& spec, const std::vector<double>& values,

@@ -88,8 +88,12 @@ EstimateResult estimate_parameters(const VehicleModelSpec& spec, const sim::Reco
                                    const EstimateSettings& settings,
                                    const std::vector<double>& initial_values = {});
 
-// The time after which a parameter's estimate stays within `band` (relative) of its final
-// value (the paper's "converges within 20 s"); t of the first sample if always inside.
+// Convergence time (the paper's "converges within 20 s"): the history time after which the
+// parameter's estimate stays within `band` (relative, e.g. 0.05) of `reference`, i.e. the
+// time of the first sample after its last exit from the band; t of the first sample if it is
+// always inside; +infinity if the last sample is outside (never converged to the reference).
+double convergence_time_to(const EstimateResult& r, std::size_t param, double band, double reference);
+// The same around the parameter's own final estimate (always finite): when it settles.
 double convergence_time(const EstimateResult& r, std::size_t param, double band);
 
 struct ValidationResult {

@@ -4,7 +4,9 @@
 // describes, and the files round-trip through the recording reader and the YAML loader.
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
+#include <set>
 #include <filesystem>
 #include <string>
 
@@ -83,40 +85,81 @@ TEST_CASE("Protocol: sensor noise has the configured statistics; commands are ex
   CHECK(steer.mean == 0.0);
 }
 
-TEST_CASE("Protocol: the five manoeuvres and the validation lap", "[sysid][protocol]") {
-  const sysid::ProtocolRun run = sysid::run_protocol(FullVehicleParams{});
-  const auto& seg = run.truth.column("segment");
-  const auto& vx = run.truth.column("vx");
-  const auto& vy = run.truth.column("vy");
-  const auto& yaw = run.truth.column("yaw");
-  auto range = [&](int s, const std::vector<double>& v, bool abs_value) {
-    double lo = 1e9, hi = -1e9, sum = 0;
-    int n = 0;
-    for (std::size_t i = 0; i < seg.size(); ++i)
-      if (seg[i] == s) {
-        const double a = abs_value ? std::abs(v[i]) : v[i];
-        lo = std::min(lo, a), hi = std::max(hi, a), sum += a, ++n;
-      }
-    return std::array<double, 3>{lo, hi, sum / n};
-  };
-  CHECK(range(1, vx, false)[2] > 4.0);  // low speed: 4-6 m/s
-  CHECK(range(1, vx, false)[1] < 6.5);
-  CHECK(range(2, vx, false)[2] > 4.0);  // zig-zag at low speed, with yaw swings
-  CHECK(range(2, vx, false)[1] < 6.5);
-  CHECK(range(3, vx, false)[1] > 9.0);  // full acceleration ...
-  CHECK(range(3, vx, false)[0] < 1.5);  // ... and braking
-  CHECK(range(4, vy, true)[1] > 2.0);   // sliding: large side slip
-  CHECK(range(5, vx, false)[1] > 9.0);  // high speed up to ~10 m/s
-  CHECK(range(5, vx, false)[1] < 11.0);
-  // Validation: one lap (yaw turns by 2 pi) at lap speeds.
-  double y0 = 0, y1 = 0;
-  bool first = true;
-  for (std::size_t i = 0; i < seg.size(); ++i)
-    if (seg[i] == 6) {
-      if (first) y0 = yaw[i], first = false;
-      y1 = yaw[i];
+TEST_CASE("Protocol layouts: 20 s of each manoeuvre; interleaved has all five in every 20 s",
+          "[sysid][protocol]") {
+  // Oracle: count 50 Hz samples per manoeuvre over the 100 s, and which manoeuvres occur in
+  // each 20 s window; the pattern clock must advance with the manoeuvre's own samples.
+  for (const auto layout : {sysid::ProtocolLayout::interleaved, sysid::ProtocolLayout::sequential}) {
+    sysid::ProtocolOptions o;
+    o.layout = layout;
+    INFO(sysid::protocol_layout_name(layout));
+    int count[6] = {0, 0, 0, 0, 0, 0};
+    std::array<std::set<int>, 5> window_segments;
+    double clock[6] = {0, 0, 0, 0, 0, 0};
+    double worst_clock = 0;
+    for (int k = 0; k < 5000; ++k) {
+      const double t = k / 50.0;
+      const auto st = sysid::protocol_segment_at(o, t);
+      REQUIRE(st.segment >= 1);
+      REQUIRE(st.segment <= 5);
+      worst_clock = std::max(worst_clock, std::abs(st.manoeuvre_time_s - clock[st.segment]));
+      clock[st.segment] += 1 / 50.0;
+      ++count[st.segment];
+      window_segments[static_cast<std::size_t>(k / 1000)].insert(st.segment);
     }
-  CHECK(std::abs(y1 - y0) == Approx(2 * M_PI).margin(0.6));
+    for (int s = 1; s <= 5; ++s) CHECK(count[s] == 1000);
+    CHECK(worst_clock < 1e-9);
+    for (const auto& w : window_segments)
+      CHECK(w.size() == (layout == sysid::ProtocolLayout::interleaved ? 5u : 1u));
+  }
+  CHECK(sysid::parse_protocol_layout("sequential") == sysid::ProtocolLayout::sequential);
+  CHECK_THROWS_WITH(sysid::parse_protocol_layout("mixed"), Catch::Contains("mixed"));
+}
+
+TEST_CASE("Protocol: the five manoeuvres and the validation lap", "[sysid][protocol]") {
+  for (const auto layout : {sysid::ProtocolLayout::interleaved, sysid::ProtocolLayout::sequential}) {
+    INFO(sysid::protocol_layout_name(layout));
+    sysid::ProtocolOptions o;
+    o.layout = layout;
+    const sysid::ProtocolRun run = sysid::run_protocol(FullVehicleParams{}, o);
+    const auto& seg = run.truth.column("segment");
+    const auto& vx = run.truth.column("vx");
+    const auto& vy = run.truth.column("vy");
+    const auto& yaw = run.truth.column("yaw");
+    // Statistics of a segment, leaving out the first 1.5 s after each change of manoeuvre (the
+    // car brakes or speeds up from the previous piece's speed).
+    auto range = [&](int s, const std::vector<double>& v, bool abs_value) {
+      double lo = 1e9, hi = -1e9, sum = 0;
+      int n = 0;
+      std::size_t since_change = 0;
+      for (std::size_t i = 0; i < seg.size(); ++i) {
+        since_change = (i > 0 && seg[i] != seg[i - 1]) ? 0 : since_change + 1;
+        if (seg[i] == s && since_change >= 75) {
+          const double a = abs_value ? std::abs(v[i]) : v[i];
+          lo = std::min(lo, a), hi = std::max(hi, a), sum += a, ++n;
+        }
+      }
+      return std::array<double, 3>{lo, hi, sum / n};
+    };
+    CHECK(range(1, vx, false)[2] > 4.0);  // low speed: 4-6 m/s
+    CHECK(range(1, vx, false)[1] < 6.5);
+    CHECK(range(2, vx, false)[2] > 4.0);  // zig-zag at low speed, with yaw swings
+    CHECK(range(2, vx, false)[1] < 6.5);
+    CHECK(range(3, vx, false)[1] > 9.0);  // full acceleration ...
+    CHECK(range(3, vx, false)[0] < 1.5);  // ... and braking
+    CHECK(range(4, vy, true)[1] > 2.0);   // sliding: large side slip
+    CHECK(range(5, vx, false)[1] > 9.0);  // high speed up to ~10 m/s
+    CHECK(range(5, vx, false)[1] < 11.0);
+    // Validation: one lap (yaw turns by 2 pi) at lap speeds.
+    double y0 = 0, y1 = 0;
+    bool first = true;
+    for (std::size_t i = 0; i < seg.size(); ++i)
+      if (seg[i] == 6) {
+        if (first) y0 = yaw[i], first = false;
+        y1 = yaw[i];
+      }
+    CHECK(std::abs(y1 - y0) == Approx(2 * M_PI).margin(0.6));
+  }
 }
 
 TEST_CASE("Protocol files: recordings and truth.yaml round-trip", "[sysid][protocol]") {

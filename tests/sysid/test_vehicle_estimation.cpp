@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "dynamics/vehicle_params.hpp"
@@ -85,6 +86,11 @@ TEST_CASE("convergence_time is the last exit from the band around the final valu
   CHECK(convergence_time(r, 0, 0.02) == 2.0);
   CHECK(convergence_time(r, 0, 0.4) == 1.0);
   CHECK(convergence_time(r, 0, 0.6) == 0.0);
+  // Around another reference (the truth): last exit from its band; never if it ends outside.
+  CHECK(convergence_time_to(r, 0, 0.02, 1.0) == 2.0);
+  CHECK(convergence_time_to(r, 0, 0.05, 1.05) == 3.0);  // 0.99 is 5.7% below 1.05, 1.01 is 3.8%
+  CHECK(convergence_time_to(r, 0, 0.02, 1.04) == std::numeric_limits<double>::infinity());
+  CHECK(convergence_time_to(r, 0, 0.6, 0.8) == 0.0);
 }
 
 TEST_CASE("estimation rejects unknown parameters and measurements by name", "[sysid][estimate]") {
