@@ -33,6 +33,10 @@
 #include "sim/summary.hpp"
 
 namespace py = pybind11;
+
+#ifdef MPPI_PY_SYSID
+void register_sysid(py::module_& m);  // bindings/sysid_py.cpp
+#endif
 using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
@@ -436,4 +440,8 @@ PYBIND11_MODULE(mppi, m) {
   }, py::arg("path"), py::arg("columns"), py::arg("metadata") = py::dict(),
         "write a CSV recording from {name: array} (t, x, y, yaw, vx, vy, yaw_rate, steer, "
         "throttle required; other columns are extras; NaN = missing)");
+
+#ifdef MPPI_PY_SYSID
+  register_sysid(m);
+#endif
 }
