@@ -43,10 +43,13 @@ const char* kUsage = R"(usage:
     --out DIR           report.json, report.md, PNG plots, corrected_model.yaml (out/diagnose)
     --no-plots          skip the PNG plots
   mppi-fit diagnose synth --out FILE.csv [--effect key=value,...] [--seed N] [--duration S]
-                          [--speed V] [--samples K] [--track NAME] [--noise-scale F]
+                          [--speed-range MIN:MAX | --speed V] [--samples K] [--track NAME]
+                          [--noise-scale F]
+                          (default: the target speed changes every 2-6 s, uniform in 3:8 m/s;
+                          --speed V holds it constant)
   mppi-fit diagnose sweep [--seeds N] [--sizes small,large] [--effects A,B,...] [--clean N]
-                          [--duration S] [--min-bic-drop B] [--out DIR]
-                          (recordings already in DIR are reused)
+                          [--duration S] [--speed-range MIN:MAX | --speed V] [--min-bic-drop B]
+                          [--out DIR]   (seeds 3, clean 4; recordings already in DIR are reused)
   mppi-fit diagnose loop --truth key=value,... --model-params FILE [--laps N] [--speed V]
                          [--samples K] [--seed N] [--out DIR]
 Effect ids: aero_drag rolling_resistance steer_delay throttle_delay steer_lag throttle_lag
@@ -128,6 +131,17 @@ int cmd_diagnose(int argc, char** argv) {
   return 0;
 }
 
+// "--speed-range A:B": the driver's target speed varies in [A, B] m/s.
+void speed_range(const std::string& flag, const std::string& text, SynthOptions* o) {
+  const auto colon = text.find(':');
+  if (colon == std::string::npos) throw UsageError(flag + " expects MIN:MAX, got '" + text + "'");
+  o->speed_min_mps = number(flag, text.substr(0, colon));
+  o->speed_max_mps = number(flag, text.substr(colon + 1));
+  if (!(o->speed_min_mps > 0 && o->speed_max_mps >= o->speed_min_mps))
+    throw UsageError(flag + ": need 0 < MIN <= MAX, got '" + text + "'");
+  o->vary_speed = true;
+}
+
 int cmd_synth(int argc, char** argv) {
   SynthOptions o;
   std::string out;
@@ -141,7 +155,10 @@ int cmd_synth(int argc, char** argv) {
     else if (f == "--effect") o.truth_ids = parse_effect_assignments(value(), &o.truth);
     else if (f == "--seed") o.seed = static_cast<std::uint64_t>(number(f, value()));
     else if (f == "--duration") o.duration_s = number(f, value());
-    else if (f == "--speed") o.target_speed_mps = number(f, value());
+    else if (f == "--speed") {
+      o.target_speed_mps = number(f, value());
+      o.vary_speed = false;
+    } else if (f == "--speed-range") speed_range(f, value(), &o);
     else if (f == "--samples") o.samples = static_cast<int>(number(f, value()));
     else if (f == "--track") o.track = value();
     else if (f == "--noise-scale") o.noise.scale = number(f, value());
@@ -155,8 +172,9 @@ int cmd_synth(int argc, char** argv) {
 }
 
 int cmd_sweep(int argc, char** argv) {
-  int seeds = 2, clean = 4;
+  int seeds = 3, clean = 4;
   SelectionOptions sel;
+  SynthOptions driver;  // the driver's speed (schedule) for every recording
   double duration = 60;
   std::vector<std::string> sizes = {"small", "large"}, effects;
   std::string out = "out/diagnose_sweep";
@@ -173,6 +191,10 @@ int cmd_sweep(int argc, char** argv) {
     else if (f == "--duration") duration = number(f, value());
     else if (f == "--out") out = value();
     else if (f == "--min-bic-drop") sel.min_bic_drop = number(f, value());
+    else if (f == "--speed") {
+      driver.target_speed_mps = number(f, value());
+      driver.vary_speed = false;
+    } else if (f == "--speed-range") speed_range(f, value(), &driver);
     else throw UsageError("unknown option " + f);
   }
   std::filesystem::create_directories(out);
@@ -184,7 +206,7 @@ int cmd_sweep(int argc, char** argv) {
   };
   std::vector<Row> rows;
   auto run_one = [&](const std::string& id, const std::string& size, const std::string& assign, int seed) {
-    SynthOptions so;
+    SynthOptions so = driver;
     so.seed = static_cast<std::uint64_t>(seed);
     so.duration_s = duration;
     if (!assign.empty()) so.truth_ids = parse_effect_assignments(assign, &so.truth);
