@@ -186,7 +186,7 @@ template <VehicleDynamics P>
 RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const Track& track,
                           const AutoRallyCost& cost) {
   ControllerSetup setup = make_controller(config, cost);
-  Controller& controller = *setup.controller;
+  Controller* controller = setup.controller.get();
   Plant<P> plant(std::move(plant_model), config.actuators, static_cast<float>(config.plant_dt_s));
   const Pose2 start = track.start_pose();
   VehicleState s0;
@@ -240,9 +240,19 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   StepSummary step_summary;
   std::optional<chassis::SimChassis> chassis;
   if (config.through_chassis) chassis.emplace();
+  std::size_t next_target = 0;  // next entry of target_speed_schedule
   while (t < max_time && laps.laps_completed() < config.laps) {
+    const auto& schedule = config.target_speed_schedule;
+    if (next_target < schedule.size() && t + 1e-9 >= schedule[next_target].first) {
+      while (next_target + 1 < schedule.size() && t + 1e-9 >= schedule[next_target + 1].first) ++next_target;
+      AutoRallyCostParams p = cost.params();
+      p.target_speed_mps = static_cast<float>(schedule[next_target].second);
+      setup = make_controller(config, AutoRallyCost(cost.map_ptr(), p));
+      controller = setup.controller.get();
+      ++next_target;
+    }
     setup.observe(plant.state(), P::kNx, model_x.data());
-    const auto u = controller.step(model_x, &step_summary);
+    const auto u = controller->step(model_x, &step_summary);
     // As on the real car, the controller's output reaches the plant through the chassis
     // interface (command validation, priorities, runstop, watchdog, calibration to pulse
     // widths and back through the simulated servos); through_chassis = false bypasses it.
@@ -271,7 +281,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
         respawn.y_m = static_cast<float>(c.point.y);
         respawn.yaw_rad = static_cast<float>(std::atan2(b.y - a.y, b.x - a.x));
         plant.reset(respawn);
-        controller.reset();
+        controller->reset();
         in_contact = false;
         break;  // new control step from the respawned state
       }
@@ -335,6 +345,13 @@ RunSummary run_closed_loop(const ClosedLoopConfig& config) {
   const AutoRallyCost cost(std::make_shared<const CostMap>(CostMap::load_npz(track.costmap_path())),
                            cost_params);
   if (config.laps < 1) throw Error("laps must be >= 1");
+  for (std::size_t i = 0; i < config.target_speed_schedule.size(); ++i) {
+    const auto& [from_s, speed] = config.target_speed_schedule[i];
+    if (!std::isfinite(from_s) || !std::isfinite(speed) ||
+        (i > 0 && from_s < config.target_speed_schedule[i - 1].first))
+      throw Error("target_speed_schedule entry " + std::to_string(i) +
+                  ": times must be finite and ascending, speeds finite");
+  }
   if (config.plant == "single-track")
     return run_with_plant(config, SingleTrack(single_track_params(config.plant_params_yaml)), track, cost);
   if (config.plant == "autorally-nn")

@@ -6,6 +6,8 @@
 // car is then put back on the centreline at rest, and the run goes on). Seeded, deterministic.
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "mppi/backend_choice.hpp"
 #include "mppi/controller_options.hpp"
@@ -21,6 +23,9 @@ struct ClosedLoopConfig {
   std::string model = "autorally-nn";     // controller model: autorally-nn | single-track | kinematic
   std::string plant = "single-track";     // simulated car: single-track | autorally-nn | kinematic
   double target_speed_mps = 6.0;          // v_x^d of the cost
+  // A driver's speed schedule: (from time [s], v_x^d [m/s]) steps in ascending time; empty =
+  // target_speed_mps throughout. At each step the controller gets the new cost and a fresh plan.
+  std::vector<std::pair<double, double>> target_speed_schedule;
   int laps = 5;                           // stop after this many laps
   double max_time_s = 0.0;                // stop after this much simulated time; 0 = from laps
   ControllerOptions controller;           // K, T, seed, threads, noise, lambda, ...

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -107,6 +108,18 @@ sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t see
   return rec;
 }
 
+std::vector<std::pair<double, double>> speed_schedule(std::uint64_t seed, double duration_s, double speed_min_mps,
+                                                      double speed_max_mps, double hold_min_s, double hold_max_s) {
+  if (!(speed_min_mps > 0 && speed_max_mps >= speed_min_mps && hold_min_s > 0 && hold_max_s >= hold_min_s &&
+        std::isfinite(speed_max_mps) && std::isfinite(hold_max_s) && std::isfinite(duration_s)))
+    throw Error("speed schedule: need 0 < speed_min_mps <= speed_max_mps and 0 < hold_min_s <= hold_max_s");
+  std::mt19937_64 rng(seed * 104729 + 3);
+  std::uniform_real_distribution<double> speed(speed_min_mps, speed_max_mps), hold(hold_min_s, hold_max_s);
+  std::vector<std::pair<double, double>> out;
+  for (double t = 0; t < duration_s; t += hold(rng)) out.emplace_back(t, speed(rng));
+  return out;
+}
+
 int synthesize(const SynthOptions& o, const std::string& csv_path) {
   if (o.work_dir.empty()) throw Error("synthesize: work_dir is required");
   std::filesystem::create_directories(o.work_dir);
@@ -122,6 +135,18 @@ int synthesize(const SynthOptions& o, const std::string& csv_path) {
   c.plant = "corrected";
   c.plant_params_yaml = truth_path;
   c.target_speed_mps = o.target_speed_mps;
+  std::string schedule_text = "constant " + std::to_string(o.target_speed_mps);
+  if (o.vary_speed && o.speed_max_mps > o.speed_min_mps) {
+    c.target_speed_schedule =
+        speed_schedule(o.seed, o.duration_s, o.speed_min_mps, o.speed_max_mps, o.hold_min_s, o.hold_max_s);
+    c.target_speed_mps = c.target_speed_schedule.front().second;
+    schedule_text.clear();
+    char b[48];
+    for (const auto& [from_s, v] : c.target_speed_schedule) {
+      std::snprintf(b, sizeof b, "%s%.2f:%.2f", schedule_text.empty() ? "" : " ", from_s, v);
+      schedule_text += b;
+    }
+  }
   c.laps = 1000;
   c.max_time_s = o.duration_s;
   c.controller.num_samples = o.samples;
@@ -144,6 +169,7 @@ int synthesize(const SynthOptions& o, const std::string& csv_path) {
                          {{"source", "mppi-fit synth"}, {"track", o.track}, {"seed", std::to_string(o.seed)},
                           {"truth_effects", ids.empty() ? "none" : ids},
                           {"truth_model", truth_path},
+                          {"target_speed_schedule_s_mps", schedule_text},
                           {"crashes", std::to_string(summary.crashes)}});
   const auto& t = raw.column("t");
   const auto& x = raw.column("x");

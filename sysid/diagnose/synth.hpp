@@ -27,7 +27,16 @@ struct SynthOptions {
   std::vector<std::string> truth_ids; // their ids, written to the metadata
   std::uint64_t seed = 1;             // MPPI and noise seed
   double duration_s = 60.0;           // recording length [s]
-  double target_speed_mps = 8.0;
+  // The driver: as on a real track, the target speed changes over time (a new v_x^d drawn
+  // uniformly in [speed_min_mps, speed_max_mps], held for hold_min_s..hold_max_s), so the
+  // recording has accelerating, cruising and braking and the throttle is not pinned at its
+  // limit. speed_min_mps == speed_max_mps (or vary_speed = false): constant target_speed_mps.
+  bool vary_speed = true;
+  double speed_min_mps = 3.0;
+  double speed_max_mps = 8.0;
+  double hold_min_s = 2.0;
+  double hold_max_s = 6.0;
+  double target_speed_mps = 8.0;      // the constant target when vary_speed is false
   std::string track = "gazebo";
   int samples = 256;                  // MPPI K (small: the generator runs many recordings)
   int horizon = 50;                   // MPPI T
@@ -35,6 +44,12 @@ struct SynthOptions {
   SensorNoise noise;
   std::string work_dir;               // scratch folder (truth file, raw log); required
 };
+
+// The driver's speed schedule: (from time [s], target speed [m/s]) steps covering
+// [0, duration_s), each speed uniform in [speed_min, speed_max], each held uniform in
+// [hold_min_s, hold_max_s]. Deterministic in `seed`. Throws mppi::Error for bad ranges.
+std::vector<std::pair<double, double>> speed_schedule(std::uint64_t seed, double duration_s, double speed_min_mps,
+                                                      double speed_max_mps, double hold_min_s, double hold_max_s);
 
 // Writes the recording to `csv_path`. Returns the number of crashes during the run.
 int synthesize(const SynthOptions& o, const std::string& csv_path);
