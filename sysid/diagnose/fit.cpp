@@ -62,18 +62,23 @@ FitResult fit_params(const FitProblem& p, const EffectParams& base, const std::v
   double mu = 1e-3;
   const std::size_t n = r0.size();
   Eigen::MatrixXd J(static_cast<Eigen::Index>(n), np);
-  for (int it = 0; it < max_iterations && np > 0 && std::isfinite(c0) && n > 0; ++it) {
-    res.iterations = it + 1;
-    for (int i = 0; i < np; ++i) {  // forward differences, stepping inwards at the bounds
+  // J <- d residuals / d parameters at u (r0 = residuals at u): forward differences, stepping
+  // inwards at the upper bounds.
+  auto jacobian_at = [&](const Eigen::VectorXd& u) {
+    for (int i = 0; i < np; ++i) {
       const ParamSpec& s = free[static_cast<std::size_t>(i)];
       double h = 0.01 * s.scale;
-      if (v[i] + h > s.hi) h = -h;
-      Eigen::VectorXd vp = v;
-      vp[i] += h;
-      residuals(p, with(vp), &r1);
+      if (u[i] + h > s.hi) h = -h;
+      Eigen::VectorXd up = u;
+      up[i] += h;
+      residuals(p, with(up), &r1);
       if (r1.size() != n) r1.assign(n, 0.0);
       for (std::size_t k = 0; k < n; ++k) J(static_cast<Eigen::Index>(k), i) = (r1[k] - r0[k]) / h;
     }
+  };
+  for (int it = 0; it < max_iterations && np > 0 && std::isfinite(c0) && n > 0; ++it) {
+    res.iterations = it + 1;
+    jacobian_at(v);
     const Eigen::Map<const Eigen::VectorXd> rv(r0.data(), static_cast<Eigen::Index>(n));
     const Eigen::MatrixXd A = J.transpose() * J;
     const Eigen::VectorXd g = J.transpose() * rv;
@@ -106,16 +111,7 @@ FitResult fit_params(const FitProblem& p, const EffectParams& base, const std::v
   // multi-step predictions (about one independent sample in five).
   Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(np, np);
   if (np > 0 && n > static_cast<std::size_t>(np) && std::isfinite(c0)) {
-    for (int i = 0; i < np; ++i) {
-      const ParamSpec& s = free[static_cast<std::size_t>(i)];
-      double h = 0.01 * s.scale;
-      if (v[i] + h > s.hi) h = -h;
-      Eigen::VectorXd vp = v;
-      vp[i] += h;
-      residuals(p, with(vp), &r1);
-      if (r1.size() != n) r1.assign(n, 0.0);
-      for (std::size_t k = 0; k < n; ++k) J(static_cast<Eigen::Index>(k), i) = (r1[k] - r0[k]) / h;
-    }
+    jacobian_at(v);
     const double s2 = c0 * static_cast<double>(n) / static_cast<double>(n - static_cast<std::size_t>(np)) * 5.0;
     const Eigen::MatrixXd A = J.transpose() * J;
     cov = A.completeOrthogonalDecomposition().pseudoInverse() * s2;
