@@ -8,12 +8,12 @@ import json
 import math
 import os
 import subprocess
-import threading
 
 import numpy as np
 import pytest
 
 import mppi
+from gil_check import run_counting_main_thread
 
 SIM = os.environ.get("MPPI_SIM_EXE", "")
 DATA = os.environ.get("MPPI_DATA_DIR") or mppi.data_dir()
@@ -175,12 +175,6 @@ def test_run_closed_loop_releases_the_gil():
     config = sim_config()
     config.laps = 1
     config.max_time_s = 4.0
-    done = []
-    worker = threading.Thread(target=lambda: done.append(mppi.run_closed_loop(config)))
-    ticks = 0
-    worker.start()
-    while worker.is_alive():
-        ticks += 1  # runs only if the C++ call does not hold the GIL
-    worker.join()
-    assert done and done[0].sim_time_s == pytest.approx(4.0, abs=0.05)
-    assert ticks > 10000
+    summary, counts = run_counting_main_thread(lambda: mppi.run_closed_loop(config))
+    assert summary.sim_time_s == pytest.approx(4.0, abs=0.05)
+    assert counts > 0  # 0 exactly when the call holds the GIL (gil_check.py)
