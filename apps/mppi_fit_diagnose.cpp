@@ -19,6 +19,7 @@
 #include "sim/closed_loop.hpp"
 #include "sim/recording.hpp"
 #include "sysid/diagnose/diagnose.hpp"
+#include "sysid/diagnose/sweep.hpp"
 #include "sysid/diagnose/synth.hpp"
 
 namespace {
@@ -38,7 +39,7 @@ const char* kUsage = R"(usage:
     --validate FILE     fit on all of --log, judge on this other recording (replaces --holdout)
     --effects A,B,...   candidate ids (default: all)
     --max-effects N     at most N effects named                              (3)
-    --min-improvement F validation-cost reduction an effect must give        (0.05)
+    --min-improvement F validation-cost reduction an effect must give        (0.03)
     --min-bic-drop B    and BIC decrease                                     (2)
     --out DIR           report.json, report.md, PNG plots, corrected_model.yaml (out/diagnose)
     --no-plots          skip the PNG plots
@@ -171,15 +172,6 @@ int cmd_synth(int argc, char** argv) {
   return 0;
 }
 
-// "Actuator dynamics" families: a pure delay and a first-order lag of the same actuator are
-// both its dynamics; at small sizes under sensor noise they are hard to tell apart. The sweep
-// reports this looser count next to (never instead of) the strict one.
-std::string actuator_family(const std::string& id) {
-  if (id == "steer_delay" || id == "steer_lag") return "steer actuator dynamics";
-  if (id == "throttle_delay" || id == "throttle_lag") return "throttle actuator dynamics";
-  return id;
-}
-
 int cmd_sweep(int argc, char** argv) {
   int seeds = 3, clean = 4;
   SelectionOptions sel;
@@ -206,42 +198,32 @@ int cmd_sweep(int argc, char** argv) {
     } else if (f == "--speed-range") speed_range(f, value(), &driver);
     else throw UsageError("unknown option " + f);
   }
+  for (const auto& id : effects) effect_spec(id);  // throws for unknown ids
   std::filesystem::create_directories(out);
-  struct Row {
-    std::string truth, size, named;
-    int seed;
-    bool right, wrong;
-    double reduction;
-    bool right_family = false, wrong_family = false;  // delay and lag of one actuator = one family
-  };
-  std::vector<Row> rows;
+  std::ofstream jsonl(out + "/runs.jsonl");
+  std::vector<SweepRun> runs;
   auto run_one = [&](const std::string& id, const std::string& size, const std::string& assign, int seed) {
     SynthOptions so = driver;
     so.seed = static_cast<std::uint64_t>(seed);
     so.duration_s = duration;
     if (!assign.empty()) so.truth_ids = parse_effect_assignments(assign, &so.truth);
-    const std::string name = (id.empty() ? "none" : id) + "_" + size + "_s" + std::to_string(seed);
+    const std::string label = id.empty() ? "none" : id;
+    const std::string name = label + "_" + size + "_s" + std::to_string(seed);
     so.work_dir = out + "/work/" + name;
-    const std::string csv = out + "/" + name + ".csv";
-    if (!std::filesystem::exists(csv)) synthesize(so, csv);  // a rerun reuses the recordings
     DiagnoseOptions o;
     o.plots = false;
     o.selection = sel;
-    const DiagnoseResult r = run_diagnosis(load_recording(csv), SingleTrackParams{}, o);
-    Row row{id.empty() ? "none" : id, size, "", seed, false, false, r.heldout_rmse_reduction};
-    for (const auto& s : r.selection.selected) {
-      row.named += (row.named.empty() ? "" : "+") + s;
-      if (std::find(so.truth_ids.begin(), so.truth_ids.end(), s) != so.truth_ids.end()) row.right = true;
-      else row.wrong = true;
-      bool family_hit = false;
-      for (const auto& t : so.truth_ids) family_hit = family_hit || actuator_family(t) == actuator_family(s);
-      (family_hit ? row.right_family : row.wrong_family) = true;
-    }
-    if (row.named.empty()) row.named = "-";
-    std::printf("%-20s %-6s seed %2d  named %-34s right %d wrong %d  held-out RMSE reduction %6.1f %%\n",
-                row.truth.c_str(), size.c_str(), seed, row.named.c_str(), row.right, row.wrong, 100 * row.reduction);
+    const SweepRun r = run_sweep_case(so, out + "/" + name + ".csv", o, label, size);
+    std::string named;
+    for (const auto& s : r.named) named += (named.empty() ? "" : "+") + s;
+    std::printf("%-18s %-5s seed %3d  named %-28s right %d wrong %d  1-s RMSE reduction %5.1f %% "
+                "(recording %5.1f %%, truth model %5.1f %%)\n",
+                label.c_str(), size.c_str(), seed, named.empty() ? "-" : named.c_str(), r.right, r.wrong,
+                100 * r.reduction_clean(), 100 * r.reduction_measured(),
+                r.before.measured > 0 ? 100 * (1 - r.truth_model.measured / r.before.measured) : 0.0);
     std::fflush(stdout);
-    rows.push_back(row);
+    jsonl << sweep_run_json(r) << "\n" << std::flush;
+    runs.push_back(r);
   };
   for (const auto& c : sweep_cases()) {
     if (!effects.empty() && std::find(effects.begin(), effects.end(), c.id) == effects.end()) continue;
@@ -249,59 +231,10 @@ int cmd_sweep(int argc, char** argv) {
       for (int s = 1; s <= seeds; ++s) run_one(c.id, size, size == "small" ? c.small : c.large, s);
   }
   for (int s = 1; s <= clean; ++s) run_one("", "clean", "", 100 + s);
-  // Summary table.
-  std::ostringstream md;
-  md << "| truth | size | runs | right named | wrong named | median held-out RMSE reduction |\n|---|---|---|---|---|---|\n";
-  int eff_runs = 0, eff_right = 0, eff_wrong = 0, clean_runs = 0, clean_named = 0, big_red = 0;
-  int fam_right = 0, fam_wrong = 0;
-  std::vector<std::string> keys;
-  for (const auto& r : rows)
-    if (std::find(keys.begin(), keys.end(), r.truth + "|" + r.size) == keys.end()) keys.push_back(r.truth + "|" + r.size);
-  for (const auto& k : keys) {
-    int n = 0, right = 0, wrong = 0;
-    std::vector<double> red;
-    for (const auto& r : rows)
-      if (r.truth + "|" + r.size == k) {
-        ++n;
-        right += r.right;
-        wrong += r.wrong;
-        red.push_back(r.reduction);
-      }
-    std::sort(red.begin(), red.end());
-    const auto bar = k.find('|');
-    char line[256];
-    std::snprintf(line, sizeof line, "| %s | %s | %d | %d | %d | %.1f %% |\n", k.substr(0, bar).c_str(),
-                  k.substr(bar + 1).c_str(), n, right, wrong, 100 * red[red.size() / 2]);
-    md << line;
-  }
-  for (const auto& r : rows) {
-    if (r.truth == "none") {
-      ++clean_runs;
-      clean_named += r.named != "-";
-    } else {
-      ++eff_runs;
-      eff_right += r.right;
-      fam_right += r.right_family;
-      fam_wrong += r.wrong_family;
-      eff_wrong += r.wrong;
-      big_red += r.reduction >= 0.5;
-    }
-  }
-  char tail[512];
-  std::snprintf(tail, sizeof tail,
-                "\nWith an effect: right effect named in %d/%d (%.0f %%), a wrong effect named in %d/%d (%.0f %%), "
-                "held-out 1-s RMSE reduced >= 50 %% in %d/%d.\nNo effect: something named in %d/%d.\n",
-                eff_right, eff_runs, eff_runs ? 100.0 * eff_right / eff_runs : 0.0, eff_wrong, eff_runs,
-                eff_runs ? 100.0 * eff_wrong / eff_runs : 0.0, big_red, eff_runs, clean_named, clean_runs);
-  md << tail;
-  std::snprintf(tail, sizeof tail,
-                "Counting a delay and a lag of the same actuator as one effect (\"actuator dynamics\"): right "
-                "%d/%d (%.0f %%), wrong %d/%d (%.0f %%).\n",
-                fam_right, eff_runs, eff_runs ? 100.0 * fam_right / eff_runs : 0.0, fam_wrong, eff_runs,
-                eff_runs ? 100.0 * fam_wrong / eff_runs : 0.0);
-  md << tail;
-  std::printf("\n%s", md.str().c_str());
-  std::ofstream(out + "/sweep.md") << md.str();
+  const std::string md = sweep_summary_markdown(runs);
+  std::printf("\n%s", md.c_str());
+  std::ofstream(out + "/sweep.md") << md;
+  std::printf("per-run metrics: %s/runs.jsonl\n", out.c_str());
   return 0;
 }
 

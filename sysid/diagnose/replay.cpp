@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+
+#include "mppi/error.hpp"
 
 namespace mppi::diagnose {
 
@@ -134,7 +137,11 @@ std::array<double, kChannels> channel_scales(const DiagData& d, const std::vecto
 std::vector<HorizonMetrics> horizon_metrics(const CorrectedSingleTrack& model, const DiagData& d,
                                             const std::vector<char>& mask,
                                             const std::vector<double>& horizons_s, int stride,
-                                            const ReplayOptions& o) {
+                                            const ReplayOptions& o, const DiagData* reference) {
+  if (reference && reference->rows() != d.rows())
+    throw Error("horizon_metrics: the reference states have " + std::to_string(reference->rows()) +
+                " rows, the recording " + std::to_string(d.rows()));
+  const DiagData& ref = reference ? *reference : d;
   std::vector<HorizonMetrics> out;
   const auto scale = channel_scales(d, mask);
   for (double hs : horizons_s) {
@@ -155,13 +162,13 @@ std::vector<HorizonMetrics> horizon_metrics(const CorrectedSingleTrack& model, c
       const std::size_t k = s.start + static_cast<std::size_t>(len);
       const double* p = pred.data() + static_cast<std::size_t>(len - 1) * kPredStride;
       for (int c = 0; c < kChannels; ++c) {
-        const double y = d.channel(c, k);
+        const double y = ref.channel(c, k);
         const double e = std::isfinite(p[c]) ? p[c] - y : 1e3;
         se[c] += e * e;
         sy[c] += y;
         sy2[c] += y * y;
       }
-      const double ex = p[3] - d.x[k], ey = p[4] - d.y[k];
+      const double ex = p[3] - ref.x[k], ey = p[4] - ref.y[k];
       pos += std::isfinite(ex + ey) ? ex * ex + ey * ey : 1e6;
     }
     const double n = static_cast<double>(segs.size());

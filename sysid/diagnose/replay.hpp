@@ -22,8 +22,11 @@ std::vector<Segment> make_segments(const DiagData& d, const std::vector<char>& m
 struct ReplayOptions {
   double substep_s = 0.002;  // integration step inside a sample interval [s] (the simulator's)
   double prime_s = 0.6;      // command history run through the actuator chains before a start [s]
-  double wheel_prime_s = 0.3;  // of which the last part runs the full model (wheel speeds) [s]
-  double observer_gain = 0.5;  // blend towards the measured velocities per sample there (1 = raw)
+  double wheel_prime_s = 0.5;  // of which the last part runs the full model (wheel speeds) [s]
+  // Blend towards the measured velocities per sample there (1 = raw). 0.25 over 25 samples
+  // averages the sensor noise of the start state down to about a third (sqrt(g / (2 - g))); a
+  // start state as noisy as the sensor would put a floor under every multi-step error.
+  double observer_gain = 0.25;
 };
 
 // Predicted vx, vy, yaw rate (and x, y) along a segment: out[(i - 1) * 5 + c] for i = 1..len,
@@ -49,9 +52,12 @@ struct HorizonMetrics {
   double position_rmse_m = 0;
   double normalized_rmse = 0;  // sqrt(mean_c (rmse_c / std_c)^2), std of the measured channel
 };
+// `reference`, when given, is what predictions are scored against instead of d's own states:
+// the noise-free states of a synthetic recording (same rows as d). Predictions still start from
+// d's (noisy) states; sensor noise on the scored sample, which no model can predict, is left out.
 std::vector<HorizonMetrics> horizon_metrics(const CorrectedSingleTrack& model, const DiagData& d,
                                             const std::vector<char>& mask,
                                             const std::vector<double>& horizons_s, int stride,
-                                            const ReplayOptions& o);
+                                            const ReplayOptions& o, const DiagData* reference = nullptr);
 
 }  // namespace mppi::diagnose
