@@ -51,8 +51,9 @@ const char* kUsage = R"(usage:
   mppi-fit diagnose sweep [--seeds N] [--sizes small,large] [--effects A,B,...] [--clean N]
                           [--duration S] [--speed-range MIN:MAX | --speed V] [--min-bic-drop B]
                           [--out DIR]   (seeds 3, clean 4; recordings already in DIR are reused)
-  mppi-fit diagnose loop --truth key=value,... --model-params FILE [--laps N] [--speed V]
-                         [--samples K] [--seed N] [--out DIR]
+  mppi-fit diagnose loop --truth key=value,... | --case ID:small|large  --model-params FILE [--laps N] [--speed V]
+                         [--samples K] [--seed N | --seeds N] [--out DIR]
+                         (--seeds N: seeds 1..N and a mean +- sd summary)
 Effect ids: aero_drag rolling_resistance steer_delay throttle_delay steer_lag throttle_lag
 steer_offset steer_gain tire_saturation friction_change load_transfer motor_voltage_sag road_grade
 )";
@@ -249,6 +250,7 @@ int cmd_loop(int argc, char** argv) {
   base.actuators.steer_rate_per_s = 1e4f;
   base.actuators.throttle_rate_per_s = 1e4f;
   std::string truth_text, model_params, out = "out/diagnose_loop";
+  int seeds = 0;  // 0 = the one --seed
   for (int i = 2; i < argc; ++i) {
     const std::string f = argv[i];
     auto value = [&]() -> std::string {
@@ -256,11 +258,23 @@ int cmd_loop(int argc, char** argv) {
       return argv[++i];
     };
     if (f == "--truth") truth_text = value();
-    else if (f == "--model-params") model_params = value();
+    else if (f == "--case") {  // ID:SIZE, the sweep's hidden effect of that size
+      const std::string v = value();
+      const auto colon = v.find(':');
+      const std::string id = v.substr(0, colon), size = colon == std::string::npos ? "large" : v.substr(colon + 1);
+      bool found = false;
+      for (const auto& c : sweep_cases())
+        if (c.id == id && (size == "small" || size == "large")) {
+          truth_text = size == "small" ? c.small : c.large;
+          found = true;
+        }
+      if (!found) throw UsageError("--case: expected EFFECT_ID:small|large, got '" + v + "'");
+    } else if (f == "--model-params") model_params = value();
     else if (f == "--laps") base.laps = static_cast<int>(number(f, value()));
     else if (f == "--speed") base.target_speed_mps = number(f, value());
     else if (f == "--samples") base.controller.num_samples = static_cast<int>(number(f, value()));
     else if (f == "--seed") base.controller.seed = static_cast<std::uint64_t>(number(f, value()));
+    else if (f == "--seeds") seeds = static_cast<int>(number(f, value()));
     else if (f == "--track") base.track = value();
     else if (f == "--out") out = value();
     else throw UsageError("unknown option " + f);
@@ -271,26 +285,67 @@ int cmd_loop(int argc, char** argv) {
   truth.selected = parse_effect_assignments(truth_text, &truth.effects);
   base.plant_params_yaml = out + "/truth_model.yaml";
   std::ofstream(base.plant_params_yaml) << corrected_model_to_yaml(truth, "truth plant of mppi-fit diagnose loop");
-  std::printf("| controller model | laps | lap times [s] | crashes | mean speed [m/s] | mean |v - v_target| [m/s] |\n|---|---|---|---|---|---|\n");
-  for (const std::string model : {"single-track", "corrected"}) {
-    sim::ClosedLoopConfig c = base;
-    c.model = model;
-    if (model == "corrected") c.model_params_yaml = model_params;
-    c.out_dir = out + "/" + model;
-    const sim::RunSummary s = sim::run_closed_loop(c);
-    const sim::Recording rec = sim::RecordingReader::read(c.out_dir + "/log.csv");
-    double err = 0;
-    const auto& vx = rec.column("vx");
-    const auto& vy = rec.column("vy");
-    for (std::size_t k = 0; k < rec.rows(); ++k) err += std::abs(std::hypot(vx[k], vy[k]) - c.target_speed_mps);
-    std::string laps;
-    for (double t : s.lap_times_s) {
-      char b[16];
-      std::snprintf(b, sizeof b, "%s%.2f", laps.empty() ? "" : ", ", t);
-      laps += b;
+  std::vector<std::uint64_t> seed_list;
+  if (seeds > 0)
+    for (int s = 1; s <= seeds; ++s) seed_list.push_back(static_cast<std::uint64_t>(s));
+  else
+    seed_list.push_back(base.controller.seed);
+  struct Totals {
+    std::vector<double> time_s, speed_err;
+    int crashes = 0, laps = 0;
+  } totals[2];
+  std::printf("| seed | controller model | laps | lap times [s] | crashes | mean speed [m/s] | mean |v - v_target| [m/s] |\n"
+              "|---|---|---|---|---|---|---|\n");
+  for (const std::uint64_t seed : seed_list)
+    for (int which = 0; which < 2; ++which) {
+      const std::string model = which == 0 ? "single-track" : "corrected";
+      sim::ClosedLoopConfig c = base;
+      c.model = model;
+      c.controller.seed = seed;
+      if (model == "corrected") c.model_params_yaml = model_params;
+      c.out_dir = out + "/" + model + (seed_list.size() > 1 ? "_s" + std::to_string(seed) : "");
+      const sim::RunSummary s = sim::run_closed_loop(c);
+      const sim::Recording rec = sim::RecordingReader::read(c.out_dir + "/log.csv");
+      double err = 0;
+      const auto& vx = rec.column("vx");
+      const auto& vy = rec.column("vy");
+      for (std::size_t k = 0; k < rec.rows(); ++k) err += std::abs(std::hypot(vx[k], vy[k]) - c.target_speed_mps);
+      std::string laps;
+      double total = 0;
+      for (double t : s.lap_times_s) {
+        char b[16];
+        std::snprintf(b, sizeof b, "%s%.2f", laps.empty() ? "" : ", ", t);
+        laps += b;
+        total += t;
+      }
+      const double mean_err = rec.rows() ? err / static_cast<double>(rec.rows()) : 0.0;
+      std::printf("| %llu | %s | %d/%d | %s | %d | %.2f | %.2f |\n", static_cast<unsigned long long>(seed),
+                  which == 0 ? "nominal single-track" : "corrected (nominal + effects)", s.laps_completed, c.laps,
+                  laps.c_str(), s.crashes, s.mean_speed_mps, mean_err);
+      std::fflush(stdout);
+      Totals& t = totals[which];
+      t.crashes += s.crashes;
+      t.laps += s.laps_completed;
+      if (s.laps_completed == c.laps) t.time_s.push_back(total);
+      t.speed_err.push_back(mean_err);
     }
-    std::printf("| %s | %d/%d | %s | %d | %.2f | %.2f |\n", model == "corrected" ? "corrected (nominal + effects)" : "nominal single-track",
-                s.laps_completed, c.laps, laps.c_str(), s.crashes, s.mean_speed_mps, rec.rows() ? err / rec.rows() : 0.0);
+  if (seed_list.size() > 1) {
+    auto mean_sd = [](const std::vector<double>& v) {
+      if (v.empty()) return std::string("-");
+      double m = 0, m2 = 0;
+      for (double x : v) m += x;
+      m /= static_cast<double>(v.size());
+      for (double x : v) m2 += (x - m) * (x - m);
+      char b[48];
+      std::snprintf(b, sizeof b, "%.2f +- %.2f", m, v.size() > 1 ? std::sqrt(m2 / static_cast<double>(v.size() - 1)) : 0.0);
+      return std::string(b);
+    };
+    std::printf("\n| controller model | seeds finishing all laps | %d-lap time [s] | crashes | mean |v - v_target| [m/s] |\n"
+                "|---|---|---|---|---|\n", base.laps);
+    for (int which = 0; which < 2; ++which)
+      std::printf("| %s | %zu/%zu | %s | %d | %s |\n", which == 0 ? "nominal single-track" : "corrected",
+                  totals[which].time_s.size(), seed_list.size(), mean_sd(totals[which].time_s).c_str(),
+                  totals[which].crashes, mean_sd(totals[which].speed_err).c_str());
   }
   return 0;
 }
