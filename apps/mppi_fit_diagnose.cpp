@@ -30,9 +30,9 @@ using namespace mppi::diagnose;
 const char* kUsage = R"(usage:
   mppi-fit diagnose --log FILE [options]         locate, name, model, show (report in --out)
     --log FILE          recording (docs/RECORDING_FORMAT.md)
-    --model NAME        nominal model: single-track (the one supported)     (single-track)
-    --params FILE       nominal parameters: single-track YAML or corrected-model file
-                        (default: the library defaults = data/config/autorally_single_track.yaml)
+    --model NAME        nominal model: single-track | double-track | full-vehicle  (single-track)
+    --params FILE       nominal parameters: that model's YAML or a corrected-model file
+                        (default: the library defaults, e.g. data/config/autorally_single_track.yaml)
     --log may also be a real recording (DART / ETH CSV, or ARCHIVE.zip:MEMBER.csv), converted
                         on the fly (sysid/real_data.hpp)
     --holdout H         held-out fraction at the end (0.3) or time range T0:T1 [s]
@@ -45,14 +45,15 @@ const char* kUsage = R"(usage:
     --no-plots          skip the PNG plots
   mppi-fit diagnose synth --out FILE.csv [--effect key=value,...] [--seed N] [--duration S]
                           [--speed-range MIN:MAX | --speed V] [--samples K] [--track NAME]
-                          [--noise-scale F]
+                          [--noise-scale F] [--nominal single-track|double-track|full-vehicle]
                           (default: the target speed changes every 2-6 s, uniform in 3:8 m/s;
                           --speed V holds it constant)
   mppi-fit diagnose sweep [--seeds N] [--sizes small,large] [--effects A,B,...] [--clean N]
                           [--duration S] [--speed-range MIN:MAX | --speed V] [--min-bic-drop B]
+                          [--nominal MODEL]  (truth base and diagnosed nominal; single-track)
                           [--out DIR]   (seeds 3, clean 4; recordings already in DIR are reused)
   mppi-fit diagnose loop --truth key=value,... | --case ID:small|large  --model-params FILE [--laps N] [--speed V]
-                         [--samples K] [--seed N | --seeds N] [--out DIR]
+                         [--samples K] [--seed N | --seeds N] [--nominal MODEL] [--out DIR]
                          (--seeds N: seeds 1..N and a mean +- sd summary)
 Effect ids: aero_drag rolling_resistance steer_delay throttle_delay steer_lag throttle_lag
 steer_offset steer_gain tire_saturation friction_change load_transfer motor_voltage_sag road_grade
@@ -108,9 +109,8 @@ int cmd_diagnose(int argc, char** argv) {
     } else throw UsageError("unknown option " + f);
   }
   if (log.empty()) throw UsageError("--log FILE is required");
-  if (model != "single-track") throw UsageError("--model: only single-track is supported, got '" + model + "'");
   for (const auto& id : o.selection.candidates) effect_spec(id);  // throws for unknown ids
-  o.model_name = model;
+  const auto nominal = make_model_family(model, params);  // throws for other models, bad files
   o.params_source = params;
   DiagData d = load_any(log);
   if (!validate.empty()) {  // fit on --log, judge on --validate
@@ -118,7 +118,7 @@ int cmd_diagnose(int argc, char** argv) {
     d = concat(d, load_any(validate));
     o.holdout = std::to_string(d.t[first] - 1e-6) + ":" + std::to_string(d.t.back() + 1.0);
   }
-  const DiagnoseResult r = run_diagnosis(d, load_nominal(params), o);
+  const DiagnoseResult r = run_diagnosis(d, *nominal, o);
   std::printf("mismatch (strongest first):\n");
   for (std::size_t i = 0; i < r.mismatch.size() && i < 8; ++i)
     std::printf("  %-9s %-45s %+.3g %s (z %.1f)\n", r.mismatch[i].channel.c_str(), r.mismatch[i].where.c_str(),
@@ -163,6 +163,7 @@ int cmd_synth(int argc, char** argv) {
     } else if (f == "--speed-range") speed_range(f, value(), &o);
     else if (f == "--samples") o.samples = static_cast<int>(number(f, value()));
     else if (f == "--track") o.track = value();
+    else if (f == "--nominal") o.nominal_model = value();
     else if (f == "--noise-scale") o.noise.scale = number(f, value());
     else throw UsageError("unknown option " + f);
   }
@@ -193,6 +194,7 @@ int cmd_sweep(int argc, char** argv) {
     else if (f == "--duration") duration = number(f, value());
     else if (f == "--out") out = value();
     else if (f == "--min-bic-drop") sel.min_bic_drop = number(f, value());
+    else if (f == "--nominal") driver.nominal_model = value();
     else if (f == "--speed") {
       driver.target_speed_mps = number(f, value());
       driver.vary_speed = false;
@@ -251,6 +253,7 @@ int cmd_loop(int argc, char** argv) {
   base.actuators.throttle_rate_per_s = 1e4f;
   std::string truth_text, model_params, out = "out/diagnose_loop";
   int seeds = 0;  // 0 = the one --seed
+  std::string nominal = "single-track";  // the plant's base and the nominal controller's model
   for (int i = 2; i < argc; ++i) {
     const std::string f = argv[i];
     auto value = [&]() -> std::string {
@@ -275,6 +278,7 @@ int cmd_loop(int argc, char** argv) {
     else if (f == "--samples") base.controller.num_samples = static_cast<int>(number(f, value()));
     else if (f == "--seed") base.controller.seed = static_cast<std::uint64_t>(number(f, value()));
     else if (f == "--seeds") seeds = static_cast<int>(number(f, value()));
+    else if (f == "--nominal") nominal = value();
     else if (f == "--track") base.track = value();
     else if (f == "--out") out = value();
     else throw UsageError("unknown option " + f);
@@ -283,6 +287,8 @@ int cmd_loop(int argc, char** argv) {
   std::filesystem::create_directories(out);
   CorrectedModelFile truth;
   truth.selected = parse_effect_assignments(truth_text, &truth.effects);
+  truth.nominal_model = nominal;
+  make_model_family(nominal);  // throws for a model that has no effects version
   base.plant_params_yaml = out + "/truth_model.yaml";
   std::ofstream(base.plant_params_yaml) << corrected_model_to_yaml(truth, "truth plant of mppi-fit diagnose loop");
   std::vector<std::uint64_t> seed_list;
@@ -298,7 +304,7 @@ int cmd_loop(int argc, char** argv) {
               "|---|---|---|---|---|---|---|\n");
   for (const std::uint64_t seed : seed_list)
     for (int which = 0; which < 2; ++which) {
-      const std::string model = which == 0 ? "single-track" : "corrected";
+      const std::string model = which == 0 ? nominal : "corrected";
       sim::ClosedLoopConfig c = base;
       c.model = model;
       c.controller.seed = seed;
@@ -320,7 +326,7 @@ int cmd_loop(int argc, char** argv) {
       }
       const double mean_err = rec.rows() ? err / static_cast<double>(rec.rows()) : 0.0;
       std::printf("| %llu | %s | %d/%d | %s | %d | %.2f | %.2f |\n", static_cast<unsigned long long>(seed),
-                  which == 0 ? "nominal single-track" : "corrected (nominal + effects)", s.laps_completed, c.laps,
+                  which == 0 ? ("nominal " + nominal).c_str() : "corrected (nominal + effects)", s.laps_completed, c.laps,
                   laps.c_str(), s.crashes, s.mean_speed_mps, mean_err);
       std::fflush(stdout);
       Totals& t = totals[which];
@@ -343,7 +349,7 @@ int cmd_loop(int argc, char** argv) {
     std::printf("\n| controller model | seeds finishing all laps | %d-lap time [s] | crashes | mean |v - v_target| [m/s] |\n"
                 "|---|---|---|---|---|\n", base.laps);
     for (int which = 0; which < 2; ++which)
-      std::printf("| %s | %zu/%zu | %s | %d | %s |\n", which == 0 ? "nominal single-track" : "corrected",
+      std::printf("| %s | %zu/%zu | %s | %d | %s |\n", which == 0 ? ("nominal " + nominal).c_str() : "corrected",
                   totals[which].time_s.size(), seed_list.size(), mean_sd(totals[which].time_s).c_str(),
                   totals[which].crashes, mean_sd(totals[which].speed_err).c_str());
   }

@@ -294,7 +294,8 @@ py::list params_list(const std::vector<mppi::diagnose::ParamEstimate>& ps) {
 
 py::dict diagnose(const std::string& log, const std::string& params, const std::string& holdout,
                   const std::string& validate_log, const std::vector<std::string>& effects, int max_effects,
-                  double min_improvement, double min_bic_drop, const std::string& out_dir, bool plots) {
+                  double min_improvement, double min_bic_drop, const std::string& out_dir, bool plots,
+                  const std::string& model) {
   using namespace mppi::diagnose;
   DiagnoseOptions o;
   o.holdout = holdout;
@@ -306,6 +307,7 @@ py::dict diagnose(const std::string& log, const std::string& params, const std::
   o.selection.min_bic_drop = min_bic_drop;
   o.params_source = params;
   for (const auto& id : effects) effect_spec(id);  // throws for an unknown id
+  const auto nominal = make_model_family(model, params);
   DiagnoseResult r;
   {
     py::gil_scoped_release release;
@@ -315,7 +317,7 @@ py::dict diagnose(const std::string& log, const std::string& params, const std::
       d = concat(d, load_any(resolve(validate_log)));
       o.holdout = std::to_string(d.t[first] - 1e-6) + ":" + std::to_string(d.t.back() + 1.0);
     }
-    r = run_diagnosis(d, load_nominal(params), o);
+    r = run_diagnosis(d, *nominal, o);
   }
   py::list mismatch, candidates;
   for (const auto& m : r.mismatch)
@@ -459,9 +461,10 @@ void register_sysid(py::module_& m) {
   m.def("diagnose", &diagnose, py::arg("log"), py::arg("params") = "", py::arg("holdout") = "0.3",
         py::arg("validate") = "", py::arg("effects") = std::vector<std::string>{}, py::arg("max_effects") = 3,
         py::arg("min_improvement") = 0.03, py::arg("min_bic_drop") = 2.0, py::arg("out_dir") = "",
-        py::arg("plots") = true,
-        "sim-vs-real diagnosis as mppi-fit diagnose: log (recording or raw real one), params (nominal "
-        "single-track YAML or corrected-model file; '' = library defaults). Returns {selected, final_params, "
+        py::arg("plots") = true, py::arg("model") = "single-track",
+        "sim-vs-real diagnosis as mppi-fit diagnose: log (recording or raw real one), model (nominal: "
+        "single-track, double-track or full-vehicle), params (that model's YAML or a corrected-model file; "
+        "'' = library defaults). Returns {selected, final_params, "
         "candidates, mismatch, fit_before, fit_after, headline_before, headline_after, heldout_rmse_reduction, "
         "model_file, log, report (report.json as a dict)}; out_dir: writes the report folder there. Releases "
         "the GIL.");

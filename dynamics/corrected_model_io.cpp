@@ -50,6 +50,7 @@ CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std:
   }
   if (!root.IsMap()) throw Error(source + ": expected a map with nominal_params and effects");
   CorrectedModelFile out;
+  std::string nominal_text;  // parsed once the nominal model is known (keys in any order)
   for (const auto& kv : root) {
     const std::string key = kv.first.as<std::string>();
     const YAML::Node& v = kv.second;
@@ -57,12 +58,16 @@ CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std:
       if (v.as<std::string>() != "corrected")
         throw Error(yaml_where(source, v.Mark()) + ": model must be 'corrected'");
     } else if (key == "nominal") {
-      if (v.as<std::string>() != "single-track")
-        throw Error(yaml_where(source, v.Mark()) + ": nominal must be 'single-track' (the only one supported)");
+      out.nominal_model = v.as<std::string>();
+      if (out.nominal_model != "single-track" && out.nominal_model != "double-track" &&
+          out.nominal_model != "full-vehicle")
+        throw Error(yaml_where(source, v.Mark()) + ": nominal must be single-track, double-track or full-vehicle, got '" +
+                    out.nominal_model + "'");
     } else if (key == "nominal_params") {
       YAML::Emitter em;
       em << v;
-      out.nominal = single_track_params_from_yaml(em.c_str(), source + " (nominal_params)");
+      nominal_text = em.c_str();
+      if (nominal_text == "~" || nominal_text == "{}") nominal_text.clear();
     } else if (key == "effects") {
       if (!v.IsMap()) throw Error(yaml_where(source, v.Mark()) + ": effects must be a map");
       for (const auto& e : v) {
@@ -88,6 +93,16 @@ CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std:
                   "' (valid: model, nominal, nominal_params, effects, selected)");
     }
   }
+  const std::string where = source + " (nominal_params)";
+  if (out.nominal_model == "double-track") {
+    if (!nominal_text.empty()) out.double_track = double_track_params_from_yaml(nominal_text, where);
+    out.nominal = out.double_track.base;
+  } else if (out.nominal_model == "full-vehicle") {
+    if (!nominal_text.empty()) out.full_vehicle = full_vehicle_params_from_yaml(nominal_text, where);
+    out.nominal = out.full_vehicle.base;
+  } else if (!nominal_text.empty()) {
+    out.nominal = single_track_params_from_yaml(nominal_text, where);
+  }
   std::string why;
   if (!out.effects.is_valid(&why)) throw Error(source + ": effects: " + why);
   return out;
@@ -109,7 +124,7 @@ std::string corrected_model_to_yaml(const CorrectedModelFile& m, const std::stri
     std::string line;
     while (std::getline(lines, line)) o << "# " << line << "\n";
   }
-  o << "model: corrected\nnominal: single-track\nselected: [";
+  o << "model: corrected\nnominal: " << m.nominal_model << "\nselected: [";
   for (std::size_t i = 0; i < m.selected.size(); ++i) o << (i ? ", " : "") << m.selected[i];
   o << "]\n";
   const EffectParams defaults;
@@ -118,6 +133,13 @@ std::string corrected_model_to_yaml(const CorrectedModelFile& m, const std::stri
   for (const auto& f : kEffectFields)
     if (m.effects.*(f.member) != defaults.*(f.member)) eff << "  " << f.key << ": " << m.effects.*(f.member) << "\n";
   o << (eff.str().empty() ? "effects: {}\n" : "effects:\n" + eff.str());
+  if (m.nominal_model == "double-track" || m.nominal_model == "full-vehicle") {
+    std::istringstream lines(m.nominal_model == "double-track" ? to_yaml(m.double_track) : to_yaml(m.full_vehicle));
+    o << "nominal_params:\n";
+    for (std::string line; std::getline(lines, line);)
+      if (!line.empty() && line[0] != '#') o << "  " << line << "\n";
+    return o.str();
+  }
   const SingleTrackParams& p = m.nominal;
   o << "nominal_params:\n"
     << "  mass_kg: " << p.mass_kg << "\n  yaw_inertia_kgm2: " << p.yaw_inertia_kgm2

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "dynamics/single_track.hpp"
+#include "dynamics/vehicle_params.hpp"
 
 namespace mppi {
 
@@ -82,9 +83,21 @@ inline SingleTrackParams apply_effect_params(SingleTrackParams p, const EffectPa
   return p;
 }
 
+// Per-step blend factors of the actuator stages, 1 - exp(-dt / tau) (1 for tau = 0); a delay
+// is rolled out as kDelayStages first-order stages of delay / kDelayStages each.
+inline constexpr int kActuatorDelayStages = 4;
+struct ActuatorAlphas {
+  float steer_delay, steer_lag, throttle_delay, throttle_lag;
+};
+inline ActuatorAlphas actuator_alphas(const EffectParams& e, float dt_s) noexcept {
+  auto a = [dt_s](double tau) { return tau > 0 ? static_cast<float>(1.0 - std::exp(-dt_s / tau)) : 1.f; };
+  return {a(e.steer_delay_s / kActuatorDelayStages), a(e.steer_lag_s), a(e.throttle_delay_s / kActuatorDelayStages),
+          a(e.throttle_lag_s)};
+}
+
 class CorrectedSingleTrack {
  public:
-  static constexpr int kDelayStages = 4;
+  static constexpr int kDelayStages = kActuatorDelayStages;
   static constexpr int kTime = SingleTrack::kNx;                     // 9
   static constexpr int kSteerChain = kTime + 1;                      // 10..14
   static constexpr int kThrottleChain = kSteerChain + kDelayStages + 1;  // 15..19
@@ -121,17 +134,7 @@ class CorrectedSingleTrack {
   const EffectParams& effects() const { return effects_; }
   std::size_t scratch_floats(int) const { return 0; }
 
-  // Per-step blend factors of the actuator stages: 1 - exp(-dt / tau), 1 for tau = 0.
-  struct Alphas {
-    float steer_delay, steer_lag, throttle_delay, throttle_lag;
-  };
-  Alphas alphas(float dt_s) const noexcept {
-    auto a = [dt_s](double tau) {
-      return tau > 0 ? static_cast<float>(1.0 - std::exp(-dt_s / tau)) : 1.f;
-    };
-    return {a(effects_.steer_delay_s / kDelayStages), a(effects_.steer_lag_s),
-            a(effects_.throttle_delay_s / kDelayStages), a(effects_.throttle_lag_s)};
-  }
+  ActuatorAlphas alphas(float dt_s) const noexcept { return actuator_alphas(effects_, dt_s); }
 
   // Advances one actuator chain (kChain floats) by one step with input u; returns the output.
   static float advance_chain(float* chain, float u, float a_delay, float a_lag) noexcept {
@@ -146,14 +149,14 @@ class CorrectedSingleTrack {
 
   // Actuator chains only, one state (used to prime them from a command history).
   void advance_actuators(float* x, float steer, float throttle, float dt_s) const noexcept {
-    const Alphas al = alphas(dt_s);
+    const ActuatorAlphas al = alphas(dt_s);
     advance_chain(x + kSteerChain, steer, al.steer_delay, al.steer_lag);
     advance_chain(x + kThrottleChain, throttle, al.throttle_delay, al.throttle_lag);
   }
 
   template <int W>
   void step(Batch<kNx, W> x, ConstBatch<kNu, W> u, float dt_s, float* /*scratch*/) const noexcept {
-    const Alphas al = alphas(dt_s);
+    const ActuatorAlphas al = alphas(dt_s);
     const SingleTrackCoeffs<float> kb = before_, ka = after_;
     const float drag = drag_per_kg_, roll = roll_per_kg_, visc = visc_per_kg_;
     const float gx = grade_x_, gy = grade_y_, tc = change_time_, gain = gain_, offset = offset_,
@@ -228,8 +231,13 @@ class CorrectedSingleTrack {
 //   nominal_params: { <single-track keys, as in data/config/autorally_single_track.yaml> }
 //   effects: { <EffectParams field>: value, ... }
 // Unknown keys, non-numbers and invalid values throw mppi::Error naming the file and key.
+//   nominal: double-track | full-vehicle (then nominal_params holds that model's keys and the
+//   effects wrap it: WithEffects<DoubleTrack / FullVehicle>, dynamics/with_effects.hpp)
 struct CorrectedModelFile {
-  SingleTrackParams nominal;
+  std::string nominal_model = "single-track";  // single-track | double-track | full-vehicle
+  SingleTrackParams nominal;          // single-track: the model; otherwise the four-wheel model's core
+  DoubleTrackParams double_track;     // nominal_model == "double-track"
+  FullVehicleParams full_vehicle;     // nominal_model == "full-vehicle"
   EffectParams effects;
   std::vector<std::string> selected;  // effect ids (informational, `selected:` list)
 };

@@ -16,6 +16,7 @@
 #include "dynamics/double_track.hpp"
 #include "dynamics/full_vehicle.hpp"
 #include "dynamics/corrected_single_track.hpp"
+#include "dynamics/with_effects.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
 #include "dynamics/single_track.hpp"
 #include "dynamics/vehicle_params.hpp"
@@ -151,6 +152,22 @@ ControllerSetup make_controller(const ClosedLoopConfig& config, const AutoRallyC
     // Nominal + fitted effects (mppi-fit diagnose); a corrected plant shares its state layout.
     if (config.model_params_yaml.empty()) throw Error("--model corrected needs --model-params FILE");
     const CorrectedModelFile file = load_corrected_model(config.model_params_yaml);
+    if (file.nominal_model == "double-track" || file.nominal_model == "full-vehicle") {
+      // Four-wheel nominal + effects (dynamics/with_effects.hpp).
+      const float radius = static_cast<float>(file.nominal.wheel_radius_m);
+      if (file.nominal_model == "double-track") {
+        const DoubleTrackWithEffects model(file.double_track, file.effects);
+        setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
+        setup.model_states = DoubleTrackWithEffects::kNx;
+        setup.observe = observe_four_wheel<DoubleTrackWithEffects>(radius);
+      } else {
+        const FullVehicleWithEffects model(file.full_vehicle, file.effects);
+        setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
+        setup.model_states = FullVehicleWithEffects::kNx;
+        setup.observe = observe_four_wheel<FullVehicleWithEffects>(radius);
+      }
+      return setup;
+    }
     const CorrectedSingleTrack model(file.nominal, file.effects);
     setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
     setup.model_states = CorrectedSingleTrack::kNx;
@@ -367,6 +384,10 @@ RunSummary run_closed_loop(const ClosedLoopConfig& config) {
   if (config.plant == "corrected") {
     if (config.plant_params_yaml.empty()) throw Error("--plant corrected needs --plant-params FILE");
     const CorrectedModelFile file = load_corrected_model(config.plant_params_yaml);
+    if (file.nominal_model == "double-track")
+      return run_with_plant(config, DoubleTrackWithEffects(file.double_track, file.effects), track, cost);
+    if (file.nominal_model == "full-vehicle")
+      return run_with_plant(config, FullVehicleWithEffects(file.full_vehicle, file.effects), track, cost);
     return run_with_plant(config, CorrectedSingleTrack(file.nominal, file.effects), track, cost);
   }
   throw Error("unknown plant '" + config.plant +

@@ -234,3 +234,9 @@ def test_diagnose_clean_recording_names_nothing(tmp_path):
     assert r["selected"] == []
     with pytest.raises(mppi.Error, match="no_such_effect"):
         mppi.diagnose(path, effects=["no_such_effect"])
+    # A nominal model without an effects version is refused by name.
+    with pytest.raises(mppi.Error, match="autorally-nn"):
+        mppi.diagnose(path, model="autorally-nn")
+    # The double-track nominal on a single-track recording: runs, reports its model.
+    r = mppi.diagnose(path, model="double-track", effects=["steer_delay"])
+    assert r["report"]["model"] == "double-track"

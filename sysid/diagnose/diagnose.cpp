@@ -43,23 +43,13 @@ const HorizonMetrics* at_horizon(const std::vector<HorizonMetrics>& ms, double h
 
 }  // namespace
 
-SingleTrackParams load_nominal(const std::string& path) {
-  if (path.empty()) return SingleTrackParams{};
-  std::ifstream in(path);
-  if (!in) throw Error("cannot open nominal parameter file '" + path + "'");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string text = ss.str();
-  if (text.find("nominal_params") != std::string::npos) return corrected_model_from_yaml(text, path).nominal;
-  return single_track_params_from_yaml(text, path);
-}
-
-DiagnoseResult run_diagnosis(const DiagData& d, const SingleTrackParams& nominal, const DiagnoseOptions& o) {
+DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, const DiagnoseOptions& o) {
   DiagnoseResult res;
   const Split split = make_split(d, o.holdout);
   std::vector<char> train(d.rows()), held = split.heldout;
   for (std::size_t k = 0; k < d.rows(); ++k) train[k] = !held[k];
-  const CorrectedSingleTrack nominal_model(nominal);
+  const auto nominal_ptr = nominal.make({});
+  const ReplayModel& nominal_model = *nominal_ptr;
 
   // 1. Locate (training part: the held-out part is kept for judging the correction).
   const ResidualSeries rs = residual_series(nominal_model, d, o.locate_horizon_s, o.replay);
@@ -67,7 +57,8 @@ DiagnoseResult run_diagnosis(const DiagData& d, const SingleTrackParams& nominal
 
   // 2. Name.
   res.selection = select_effects(d, nominal, train, held, o.selection, o.replay);
-  const CorrectedSingleTrack corrected(nominal, res.selection.final_effects);
+  const auto corrected_ptr = nominal.make(res.selection.final_effects);
+  const ReplayModel& corrected = *corrected_ptr;
 
   // 4. Show (held out): one-step, then the multi-step horizons.
   std::vector<double> hs = {d.dt_s};
@@ -83,10 +74,7 @@ DiagnoseResult run_diagnosis(const DiagData& d, const SingleTrackParams& nominal
   }
 
   // 3. Model file.
-  CorrectedModelFile file;
-  file.nominal = nominal;
-  file.effects = res.selection.final_effects;
-  file.selected = res.selection.selected;
+  CorrectedModelFile file = nominal.file(res.selection.final_effects, res.selection.selected);
   // The controller has no clock of the recording: a grip change is written as the grip after it.
   if (file.effects.grip_change_time_s > 0 && file.effects.grip_scale != 1.0) {
     file.effects.grip_change_time_s = 0.0;
@@ -103,7 +91,7 @@ DiagnoseResult run_diagnosis(const DiagData& d, const SingleTrackParams& nominal
   // JSON.
   json j;
   j["log"] = d.source;
-  j["model"] = o.model_name;
+  j["model"] = nominal.name();
   j["params"] = o.params_source;
   j["rows"] = d.rows();
   j["dt_s"] = d.dt_s;
@@ -173,7 +161,7 @@ DiagnoseResult run_diagnosis(const DiagData& d, const SingleTrackParams& nominal
     md.precision(4);
     md << "# Sim-vs-real diagnosis\n\n"
        << "- recording: `" << d.source << "` (" << d.rows() << " rows, dt " << d.dt_s << " s), held out: `" << o.holdout
-       << "`\n- nominal model: " << o.model_name << (o.params_source.empty() ? " (library defaults)" : " from `" + o.params_source + "`")
+       << "`\n- nominal model: " << nominal.name() << (o.params_source.empty() ? " (library defaults)" : " from `" + o.params_source + "`")
        << "\n- corrected model: `" << res.model_file << "`\n\n## Named effects\n\n";
     if (res.selection.selected.empty()) md << "None: no candidate improved the validation error enough (the nominal model stands).\n";
     for (const auto& id : res.selection.selected) md << "- **" << id << "**: " << effect_spec(id).description << "\n";

@@ -5,10 +5,10 @@
 #include <string>
 #include <vector>
 
-#include "dynamics/corrected_single_track.hpp"
 #include "sysid/diagnose/data.hpp"
 #include "sysid/diagnose/fit.hpp"
 #include "sysid/diagnose/locate.hpp"
+#include "sysid/diagnose/model_family.hpp"
 #include "sysid/diagnose/replay.hpp"
 
 namespace mppi::diagnose {
@@ -22,7 +22,6 @@ struct DiagnoseOptions {
   SelectionOptions selection;
   ReplayOptions replay;
   bool plots = true;
-  std::string model_name = "single-track";  // for the report
   std::string params_source;            // nominal parameter file, for the report
 };
 
@@ -36,10 +35,7 @@ struct DiagnoseResult {
   std::string json;                           // report.json text
 };
 
-DiagnoseResult run_diagnosis(const DiagData& d, const SingleTrackParams& nominal, const DiagnoseOptions& o);
-
-// The nominal parameters from a file: a single-track parameter YAML, or a corrected-model file
-// (its nominal part; its effects are ignored). Empty path = the library defaults.
-SingleTrackParams load_nominal(const std::string& path);
+// `nominal`: make_model_family(model, params file) (sysid/diagnose/model_family.hpp).
+DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, const DiagnoseOptions& o);
 
 }  // namespace mppi::diagnose

@@ -12,28 +12,28 @@
 namespace mppi::diagnose {
 namespace {
 
-bool make_model(const FitProblem& p, const EffectParams& e, CorrectedSingleTrack* out) {
+// nullptr for parameters outside what the model accepts (treated as a bad point).
+std::unique_ptr<ReplayModel> make_model(const ModelFamily& family, const EffectParams& e) {
   try {
-    *out = CorrectedSingleTrack(p.nominal, e);
-    return true;
+    return family.make(e);
   } catch (const Error&) {
-    return false;  // parameters outside what the model accepts: treated as a bad point
+    return nullptr;
   }
 }
 
 double residuals(const FitProblem& p, const EffectParams& e, std::vector<double>* r) {
-  CorrectedSingleTrack m;
-  if (!make_model(p, e, &m)) {
+  const auto m = make_model(*p.family, e);
+  if (!m) {
     r->clear();
     return std::numeric_limits<double>::infinity();
   }
-  segment_residuals(m, *p.data, p.segments, p.scale, p.replay, r);
+  segment_residuals(*m, *p.data, p.segments, p.scale, p.replay, r);
   double s = 0;
   for (double v : *r) s += v * v;
   return r->empty() ? 0.0 : s / static_cast<double>(r->size());
 }
 
-double heldout_1s_normalized_rmse(const CorrectedSingleTrack& m, const DiagData& d, const std::vector<char>& mask,
+double heldout_1s_normalized_rmse(const ReplayModel& m, const DiagData& d, const std::vector<char>& mask,
                                 const ReplayOptions& o) {
   return horizon_metrics(m, d, mask, {1.0}, 5, o)[0].normalized_rmse;
 }
@@ -164,7 +164,7 @@ FitResult fit_effect(const FitProblem& p, const EffectParams& base, const Effect
   return fit_params(p, start, spec.params);
 }
 
-Selection select_effects(const DiagData& d, const SingleTrackParams& nominal,
+Selection select_effects(const DiagData& d, const ModelFamily& nominal,
                          const std::vector<char>& train_mask, const std::vector<char>& heldout_mask,
                          const SelectionOptions& opt, const ReplayOptions& replay) {
   Selection sel;
@@ -175,7 +175,7 @@ Selection select_effects(const DiagData& d, const SingleTrackParams& nominal,
                 " segments of " + std::to_string(opt.fit_horizon_s) + " s (need >= 6)");
   FitProblem all, fit, val;
   all.data = fit.data = val.data = &d;
-  all.nominal = fit.nominal = val.nominal = nominal;
+  all.family = fit.family = val.family = &nominal;
   all.replay = fit.replay = val.replay = replay;
   all.scale = fit.scale = val.scale = channel_scales(d, train_mask);
   all.segments = segs;
@@ -189,7 +189,7 @@ Selection select_effects(const DiagData& d, const SingleTrackParams& nominal,
   else
     for (const auto& id : opt.candidates) cands.push_back(&effect_spec(id));
 
-  const double held_nominal = heldout_1s_normalized_rmse(CorrectedSingleTrack(nominal), d, heldout_mask, replay);
+  const double held_nominal = heldout_1s_normalized_rmse(*nominal.make({}), d, heldout_mask, replay);
   EffectParams base;
   double base_fit = mean_cost(fit, base), base_val = mean_cost(val, base);
   char line[512];
@@ -215,9 +215,9 @@ Selection select_effects(const DiagData& d, const SingleTrackParams& nominal,
         c.params = r.params;
         c.val_improvement = impr;
         c.bic_delta = bic;
-        CorrectedSingleTrack m;
+        const auto m = make_model(nominal, r.effects);
         c.heldout_improvement =
-            make_model(all, r.effects, &m) ? 1.0 - heldout_1s_normalized_rmse(m, d, heldout_mask, replay) / held_nominal : 0.0;
+            m ? 1.0 - heldout_1s_normalized_rmse(*m, d, heldout_mask, replay) / held_nominal : 0.0;
       }
       std::snprintf(line, sizeof line, "round %d: %-18s validation %+6.1f %%, dBIC %+9.1f", round,
                     cands[i]->id.c_str(), 100 * impr, bic);

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "dynamics/corrected_single_track.hpp"
 #include "sysid/diagnose/data.hpp"
 #include "sysid/diagnose/effects.hpp"
+#include "sysid/diagnose/model_family.hpp"
 #include "sysid/diagnose/replay.hpp"
 
 namespace mppi::diagnose {
@@ -17,7 +17,7 @@ namespace mppi::diagnose {
 // The data a fit works on: segments and channel scales.
 struct FitProblem {
   const DiagData* data = nullptr;
-  SingleTrackParams nominal;
+  const ModelFamily* family = nullptr;  // the nominal model; members = nominal + effects
   std::vector<Segment> segments;
   std::array<double, kChannels> scale{};
   ReplayOptions replay;
@@ -76,7 +76,7 @@ struct Selection {
 
 // Runs the selection on the training rows (train_mask), reporting held-out numbers on
 // heldout_mask.
-Selection select_effects(const DiagData& d, const SingleTrackParams& nominal,
+Selection select_effects(const DiagData& d, const ModelFamily& nominal,
                          const std::vector<char>& train_mask, const std::vector<char>& heldout_mask,
                          const SelectionOptions& options = {}, const ReplayOptions& replay = {});
 

@@ -8,7 +8,7 @@
 
 namespace mppi::diagnose {
 
-ResidualSeries residual_series(const CorrectedSingleTrack& model, const DiagData& d, double horizon_s,
+ResidualSeries residual_series(const ReplayModel& model, const DiagData& d, double horizon_s,
                                const ReplayOptions& o) {
   ResidualSeries rs;
   const int len = std::max(1, static_cast<int>(std::lround(horizon_s / d.dt_s)));

@@ -17,7 +17,7 @@ struct ResidualSeries {
   double horizon_s = 0.2;
   std::vector<double> e[kChannels];
 };
-ResidualSeries residual_series(const CorrectedSingleTrack& model, const DiagData& d, double horizon_s,
+ResidualSeries residual_series(const ReplayModel& model, const DiagData& d, double horizon_s,
                                const ReplayOptions& o = {});
 
 // The regime variables, per row.

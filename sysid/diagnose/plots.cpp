@@ -104,8 +104,8 @@ void plot_residual_vs_regime(const std::string& png, const DiagData& d, const Re
   write_png(png, img);
 }
 
-void plot_overlay(const std::string& png, const DiagData& d, const CorrectedSingleTrack& nominal,
-                  const CorrectedSingleTrack& corrected, const std::vector<char>& mask, const ReplayOptions& o) {
+void plot_overlay(const std::string& png, const DiagData& d, const ReplayModel& nominal,
+                  const ReplayModel& corrected, const std::vector<char>& mask, const ReplayOptions& o) {
   const int W = 1200, H = 1000;
   cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
   text(img, "held out: measured (black), nominal (red), corrected (blue) open-loop predictions", {70, 22}, 0.5);

@@ -19,7 +19,7 @@ void plot_residual_vs_regime(const std::string& png, const DiagData& d, const Re
 // Top: x-y of the held-out part with 2-s open-loop predictions every 1 s (nominal red,
 // corrected blue, measured black); below: vx and yaw rate against time with the 1-s-ahead
 // predictions.
-void plot_overlay(const std::string& png, const DiagData& d, const CorrectedSingleTrack& nominal,
-                  const CorrectedSingleTrack& corrected, const std::vector<char>& mask, const ReplayOptions& o);
+void plot_overlay(const std::string& png, const DiagData& d, const ReplayModel& nominal,
+                  const ReplayModel& corrected, const std::vector<char>& mask, const ReplayOptions& o);
 
 }  // namespace mppi::diagnose

@@ -25,9 +25,9 @@ std::vector<Segment> make_segments(const DiagData& d, const std::vector<char>& m
   return out;
 }
 
-void predict_segment(const CorrectedSingleTrack& model, const DiagData& d, const Segment& s,
+void predict_segment(const ReplayModel& model, const DiagData& d, const Segment& s,
                      const ReplayOptions& o, double* out) {
-  float x[CorrectedSingleTrack::kNx];
+  float x[ReplayModel::kMaxStates];
   VehicleState vs;
   const std::size_t k0 = s.start;
   vs.x_m = static_cast<float>(d.x[k0]);
@@ -37,15 +37,15 @@ void predict_segment(const CorrectedSingleTrack& model, const DiagData& d, const
   vs.vy_mps = static_cast<float>(d.vy[k0]);
   vs.yaw_rate_radps = static_cast<float>(d.r[k0]);
   model.init_state(vs, x);
-  x[CorrectedSingleTrack::kTime] = static_cast<float>(d.t[k0]);
+  const int time_state = model.time_index();
+  x[time_state] = static_cast<float>(d.t[k0]);
   // Unmeasured states (actuator chains, wheel speeds): run the model over the history before
   // the start with its measured states forced back to the recording at every sample, so that
   // they settle where this model puts them; then start from the measured state.
   std::size_t h = k0;
   const int prime_rows = static_cast<int>(std::lround(o.prime_s / d.dt_s));
   for (int i = 0; i < prime_rows && h > 0 && d.piece[h - 1] == d.piece[k0]; ++i) --h;
-  CorrectedSingleTrack::set_actuators(x, static_cast<float>(d.steer_over(h)),
-                                      static_cast<float>(d.throttle_over(h)));
+  model.set_actuators(x, static_cast<float>(d.steer_over(h)), static_cast<float>(d.throttle_over(h)));
   // Velocities: a constant-gain observer (blend of the model's value and the measurement) once
   // the full model runs, which takes sensor noise off the start state; the rest measured.
   bool observing = false;
@@ -57,7 +57,7 @@ void predict_segment(const CorrectedSingleTrack& model, const DiagData& d, const
     x[state::kVx] += g * (static_cast<float>(d.vx[k]) - x[state::kVx]);
     x[state::kVy] += g * (static_cast<float>(d.vy[k]) - x[state::kVy]);
     x[state::kYawRate] += g * (static_cast<float>(d.r[k]) - x[state::kYawRate]);
-    x[CorrectedSingleTrack::kTime] = static_cast<float>(d.t[k]);
+    x[time_state] = static_cast<float>(d.t[k]);
   };
   float u[2];
   for (std::size_t k = h; k < k0; ++k) {
@@ -71,7 +71,7 @@ void predict_segment(const CorrectedSingleTrack& model, const DiagData& d, const
       continue;
     }
     for (int j = 0; j < n; ++j)
-      model.step<1>(Batch<CorrectedSingleTrack::kNx, 1>{x}, ConstBatch<2, 1>{u}, static_cast<float>(dt / n), nullptr);
+      model.step(x, u[0], u[1], static_cast<float>(dt / n));
     observing = true;
   }
   force_measured(k0);
@@ -83,7 +83,7 @@ void predict_segment(const CorrectedSingleTrack& model, const DiagData& d, const
     u[0] = static_cast<float>(d.steer_over(k));
     u[1] = static_cast<float>(d.throttle_over(k));
     for (int j = 0; j < n; ++j)
-      model.step<1>(Batch<CorrectedSingleTrack::kNx, 1>{x}, ConstBatch<2, 1>{u}, h_s, nullptr);
+      model.step(x, u[0], u[1], h_s);
     double* o5 = out + static_cast<std::ptrdiff_t>(i) * kPredStride;
     o5[0] = x[state::kVx];
     o5[1] = x[state::kVy];
@@ -93,7 +93,7 @@ void predict_segment(const CorrectedSingleTrack& model, const DiagData& d, const
   }
 }
 
-void segment_residuals(const CorrectedSingleTrack& model, const DiagData& d,
+void segment_residuals(const ReplayModel& model, const DiagData& d,
                        const std::vector<Segment>& segs, const std::array<double, kChannels>& scale,
                        const ReplayOptions& o, std::vector<double>* res) {
   std::size_t total = 0;
@@ -134,7 +134,7 @@ std::array<double, kChannels> channel_scales(const DiagData& d, const std::vecto
   return out;
 }
 
-std::vector<HorizonMetrics> horizon_metrics(const CorrectedSingleTrack& model, const DiagData& d,
+std::vector<HorizonMetrics> horizon_metrics(const ReplayModel& model, const DiagData& d,
                                             const std::vector<char>& mask,
                                             const std::vector<double>& horizons_s, int stride,
                                             const ReplayOptions& o, const DiagData* reference) {

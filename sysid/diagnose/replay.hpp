@@ -4,8 +4,8 @@
 #include <array>
 #include <vector>
 
-#include "dynamics/corrected_single_track.hpp"
 #include "sysid/diagnose/data.hpp"
+#include "sysid/diagnose/model_family.hpp"
 
 namespace mppi::diagnose {
 
@@ -32,12 +32,12 @@ struct ReplayOptions {
 // Predicted vx, vy, yaw rate (and x, y) along a segment: out[(i - 1) * 5 + c] for i = 1..len,
 // c = vx, vy, yaw_rate, x, y.
 inline constexpr int kPredStride = 5;
-void predict_segment(const CorrectedSingleTrack& model, const DiagData& d, const Segment& s,
+void predict_segment(const ReplayModel& model, const DiagData& d, const Segment& s,
                      const ReplayOptions& o, double* out);
 
 // Weighted residuals (prediction - measurement) / scale_c for every sample of every segment,
 // channels vx, vy, yaw_rate; appended to `res` (resized).
-void segment_residuals(const CorrectedSingleTrack& model, const DiagData& d,
+void segment_residuals(const ReplayModel& model, const DiagData& d,
                        const std::vector<Segment>& segs, const std::array<double, kChannels>& scale,
                        const ReplayOptions& o, std::vector<double>* res);
 
@@ -55,7 +55,7 @@ struct HorizonMetrics {
 // `reference`, when given, is what predictions are scored against instead of d's own states:
 // the noise-free states of a synthetic recording (same rows as d). Predictions still start from
 // d's (noisy) states; sensor noise on the scored sample, which no model can predict, is left out.
-std::vector<HorizonMetrics> horizon_metrics(const CorrectedSingleTrack& model, const DiagData& d,
+std::vector<HorizonMetrics> horizon_metrics(const ReplayModel& model, const DiagData& d,
                                             const std::vector<char>& mask,
                                             const std::vector<double>& horizons_s, int stride,
                                             const ReplayOptions& o, const DiagData* reference = nullptr);

@@ -47,7 +47,8 @@ SweepRun run_sweep_case(const SynthOptions& so, const std::string& csv, const Di
   if (!std::filesystem::exists(csv)) synthesize(so, csv);
   const DiagData d = load_recording(csv);
   const DiagData clean = load_recording(so.work_dir + "/run/log.csv");  // the noise-free states
-  const DiagnoseResult r = run_diagnosis(d, SingleTrackParams{}, o);
+  const auto family = make_model_family(so.nominal_model);
+  const DiagnoseResult r = run_diagnosis(d, *family, o);
 
   SweepRun run;
   run.truth = truth_label;
@@ -69,16 +70,16 @@ SweepRun run_sweep_case(const SynthOptions& so, const std::string& csv, const Di
   std::vector<double> hs = {d.dt_s};
   hs.insert(hs.end(), o.horizons_s.begin(), o.horizons_s.end());
   const CorrectedModelFile truth_file = load_corrected_model(so.work_dir + "/truth_model.yaml");
-  const CorrectedSingleTrack nominal(SingleTrackParams{});
-  const CorrectedSingleTrack corrected(SingleTrackParams{}, r.selection.final_effects);
-  const CorrectedSingleTrack truth(truth_file.nominal, truth_file.effects);
-  run.before_h = horizon_metrics(nominal, d, split.heldout, hs, 5, o.replay, &clean);
-  run.after_h = horizon_metrics(corrected, d, split.heldout, hs, 5, o.replay, &clean);
-  run.truth_h = horizon_metrics(truth, d, split.heldout, hs, 5, o.replay, &clean);
+  const auto nominal = family->make({});
+  const auto corrected = family->make(r.selection.final_effects);
+  const auto truth = model_family_of(truth_file)->make(truth_file.effects);
+  run.before_h = horizon_metrics(*nominal, d, split.heldout, hs, 5, o.replay, &clean);
+  run.after_h = horizon_metrics(*corrected, d, split.heldout, hs, 5, o.replay, &clean);
+  run.truth_h = horizon_metrics(*truth, d, split.heldout, hs, 5, o.replay, &clean);
   const double h = o.headline_horizon_s;
   run.before = {r.headline_before, headline(run.before_h, h)};
   run.after = {r.headline_after, headline(run.after_h, h)};
-  run.truth_model = {headline(horizon_metrics(truth, d, split.heldout, hs, 5, o.replay), h),
+  run.truth_model = {headline(horizon_metrics(*truth, d, split.heldout, hs, 5, o.replay), h),
                      headline(run.truth_h, h)};
   return run;
 }

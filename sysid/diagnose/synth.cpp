@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "mppi/error.hpp"
+#include "dynamics/with_effects.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/plant.hpp"
 #include "sim/recording.hpp"
@@ -66,11 +67,13 @@ const std::vector<SweepCase>& sweep_cases() {
   return cases;
 }
 
-sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t seed, double duration_s,
-                                    const SensorNoise& noise) {
+namespace {
+
+template <VehicleDynamics M>
+sim::Recording drive_open_loop(M truth_model, std::uint64_t seed, double duration_s, const SensorNoise& noise) {
   sim::ActuatorLimits fast;
   fast.steer_rate_per_s = fast.throttle_rate_per_s = 1e4f;
-  sim::Plant<CorrectedSingleTrack> plant(CorrectedSingleTrack(SingleTrackParams{}, truth), fast, 0.002f);
+  sim::Plant<M> plant(std::move(truth_model), fast, 0.002f);
   VehicleState s0;
   s0.vx_mps = 4.f;
   plant.reset(s0);
@@ -108,6 +111,19 @@ sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t see
   return rec;
 }
 
+}  // namespace
+
+sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t seed, double duration_s,
+                                    const SensorNoise& noise, const std::string& nominal_model) {
+  if (nominal_model == "double-track")
+    return drive_open_loop(DoubleTrackWithEffects(DoubleTrackParams{}, truth), seed, duration_s, noise);
+  if (nominal_model == "full-vehicle")
+    return drive_open_loop(FullVehicleWithEffects(FullVehicleParams{}, truth), seed, duration_s, noise);
+  if (nominal_model != "single-track")
+    throw Error("synthesize_open_loop: unknown nominal model '" + nominal_model + "'");
+  return drive_open_loop(CorrectedSingleTrack(SingleTrackParams{}, truth), seed, duration_s, noise);
+}
+
 std::vector<std::pair<double, double>> speed_schedule(std::uint64_t seed, double duration_s, double speed_min_mps,
                                                       double speed_max_mps, double hold_min_s, double hold_max_s) {
   if (!(speed_min_mps > 0 && speed_max_mps >= speed_min_mps && hold_min_s > 0 && hold_max_s >= hold_min_s &&
@@ -123,7 +139,10 @@ std::vector<std::pair<double, double>> speed_schedule(std::uint64_t seed, double
 int synthesize(const SynthOptions& o, const std::string& csv_path) {
   if (o.work_dir.empty()) throw Error("synthesize: work_dir is required");
   std::filesystem::create_directories(o.work_dir);
+  if (o.nominal_model != "single-track" && o.nominal_model != "double-track" && o.nominal_model != "full-vehicle")
+    throw Error("synthesize: unknown nominal model '" + o.nominal_model + "'");
   CorrectedModelFile truth;
+  truth.nominal_model = o.nominal_model;
   truth.effects = o.truth;
   truth.selected = o.truth_ids;
   const std::string truth_path = o.work_dir + "/truth_model.yaml";
@@ -131,7 +150,7 @@ int synthesize(const SynthOptions& o, const std::string& csv_path) {
 
   sim::ClosedLoopConfig c;
   c.track = o.track;
-  c.model = "single-track";
+  c.model = o.nominal_model;
   c.plant = "corrected";
   c.plant_params_yaml = truth_path;
   c.target_speed_mps = o.target_speed_mps;

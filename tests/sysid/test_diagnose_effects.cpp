@@ -23,8 +23,10 @@ namespace {
 
 // Training problem over the whole recording: 0.5 s segments.
 FitProblem problem_for(const DiagData& d) {
+  static const auto family = make_model_family("single-track");
   FitProblem p;
   p.data = &d;
+  p.family = family.get();
   p.segments = make_segments(d, {}, 25, 25);
   p.scale = channel_scales(d, {});
   return p;

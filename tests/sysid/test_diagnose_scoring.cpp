@@ -44,7 +44,8 @@ TEST_CASE("scoring against noise-free states removes exactly the sensor noise of
   REQUIRE(d.noisy.vx[100] != d.clean.vx[100]);
   REQUIRE(d.noisy.steer[100] == d.clean.steer[100]);
   const std::vector<char> all;
-  const CorrectedSingleTrack truth_model(SingleTrackParams{}, truth);
+  const auto truth_ptr = make_model_family("single-track")->make(truth);
+  const ReplayModel& truth_model = *truth_ptr;
   const ReplayOptions o;
   const auto measured = horizon_metrics(truth_model, d.noisy, all, {0.5, 1.0}, 3, o);
   const auto clean = horizon_metrics(truth_model, d.noisy, all, {0.5, 1.0}, 3, o, &d.clean);
@@ -58,20 +59,21 @@ TEST_CASE("scoring against noise-free states removes exactly the sensor noise of
       CHECK(clean[h].rmse[c] < 0.7 * measured[h].rmse[c]);  // the truth model is near the floor
     }
   // The nominal model misses the delay: scored either way, its error is above the truth model's.
-  const auto nominal_clean = horizon_metrics(CorrectedSingleTrack(SingleTrackParams{}), d.noisy, all, {1.0}, 3, o, &d.clean);
+  const auto nominal_clean = horizon_metrics(*make_model_family("single-track")->make({}), d.noisy, all, {1.0}, 3, o, &d.clean);
   CHECK(nominal_clean[0].normalized_rmse > 2 * clean[1].normalized_rmse);
 }
 
 TEST_CASE("a reference with other rows is refused", "[diagnose][scoring]") {
   const NoisyAndClean d = drive(EffectParams{}, 32);
   const DiagData shorter = prepare(synthesize_open_loop(EffectParams{}, 32, 20.0), "shorter");
-  CHECK_THROWS_AS(horizon_metrics(CorrectedSingleTrack(SingleTrackParams{}), d.noisy, {}, {1.0}, 3, {}, &shorter),
+  CHECK_THROWS_AS(horizon_metrics(*make_model_family("single-track")->make({}), d.noisy, {}, {1.0}, 3, {}, &shorter),
                   Error);
 }
 
 TEST_CASE("the start-state observer takes most of the sensor noise off the start state", "[diagnose][scoring]") {
   const NoisyAndClean d = drive(EffectParams{}, 33);
-  const CorrectedSingleTrack truth_model(SingleTrackParams{});
+  const auto truth_ptr = make_model_family("single-track")->make({});
+  const ReplayModel& truth_model = *truth_ptr;
   ReplayOptions raw;
   raw.observer_gain = 1.0;  // start from the measured state as it is
   const ReplayOptions observed;

@@ -27,7 +27,7 @@ DiagnoseResult diagnose_synthetic(const std::string& truth_text, std::uint64_t s
   DiagnoseOptions o;
   o.out_dir = out_dir;
   o.plots = !out_dir.empty();
-  return run_diagnosis(d, SingleTrackParams{}, o);
+  return run_diagnosis(d, *make_model_family("single-track"), o);
 }
 
 }  // namespace

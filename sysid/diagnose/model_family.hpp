@@ -1,0 +1,48 @@
+#pragma once
+// The nominal model a diagnosis starts from, as a family of "nominal + effects" models: one
+// member per set of effect values. Single-track (CorrectedSingleTrack, every effect inside its
+// force balance), double-track and full-vehicle (WithEffects<...>, dynamics/with_effects.hpp).
+// The replay and the fits see a member through ReplayModel: one state vector, stepped one
+// sample at a time (offline work, so a virtual call per step is fine here).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dynamics/corrected_single_track.hpp"
+
+namespace mppi::diagnose {
+
+class ReplayModel {
+ public:
+  static constexpr int kMaxStates = 64;
+  virtual ~ReplayModel() = default;
+  virtual int states() const = 0;        // <= kMaxStates
+  virtual int time_index() const = 0;    // the state that holds time [s] (grip changes)
+  virtual void init_state(const VehicleState& s, float* x) const = 0;
+  virtual void set_actuators(float* x, float steer, float throttle) const = 0;  // steady command
+  virtual void advance_actuators(float* x, float steer, float throttle, float dt_s) const = 0;
+  virtual void step(float* x, float steer, float throttle, float dt_s) const = 0;
+};
+
+class ModelFamily {
+ public:
+  virtual ~ModelFamily() = default;
+  virtual const std::string& name() const = 0;  // single-track | double-track | full-vehicle
+  // The member with these effects; throws mppi::Error where the values make the model invalid.
+  virtual std::unique_ptr<ReplayModel> make(const EffectParams& effects) const = 0;
+  // The corrected-model file of a member (corrected_model_to_yaml's input).
+  virtual CorrectedModelFile file(const EffectParams& effects, const std::vector<std::string>& selected) const = 0;
+};
+
+// "single-track" | "double-track" | "full-vehicle" with parameters from `params_path` (that
+// model's YAML, or a corrected-model file whose nominal part is used; empty = the library
+// defaults). Throws mppi::Error naming the model or file.
+std::unique_ptr<ModelFamily> make_model_family(const std::string& model, const std::string& params_path = "");
+
+// The family of a corrected-model file's nominal model (its effects are ignored).
+std::unique_ptr<ModelFamily> model_family_of(const CorrectedModelFile& file);
+
+// The models a diagnosis can start from, for messages.
+inline constexpr const char* kDiagnoseModels = "single-track, double-track, full-vehicle";
+
+}  // namespace mppi::diagnose
