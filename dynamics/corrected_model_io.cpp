@@ -51,6 +51,7 @@ CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std:
   if (!root.IsMap()) throw Error(source + ": expected a map with nominal_params and effects");
   CorrectedModelFile out;
   std::string nominal_text;  // parsed once the nominal model is known (keys in any order)
+  YAML::Node nominal_node;
   for (const auto& kv : root) {
     const std::string key = kv.first.as<std::string>();
     const YAML::Node& v = kv.second;
@@ -59,15 +60,16 @@ CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std:
         throw Error(yaml_where(source, v.Mark()) + ": model must be 'corrected'");
     } else if (key == "nominal") {
       out.nominal_model = v.as<std::string>();
-      if (out.nominal_model != "single-track" && out.nominal_model != "double-track" &&
-          out.nominal_model != "full-vehicle")
-        throw Error(yaml_where(source, v.Mark()) + ": nominal must be single-track, double-track or full-vehicle, got '" +
-                    out.nominal_model + "'");
+      const std::string& n = out.nominal_model;
+      if (n != "single-track" && n != "double-track" && n != "full-vehicle" && n != "kinematic" && n != "autorally-nn")
+        throw Error(yaml_where(source, v.Mark()) + ": nominal must be one of " + kCorrectedNominalModels + ", got '" +
+                    n + "'");
     } else if (key == "nominal_params") {
       YAML::Emitter em;
       em << v;
       nominal_text = em.c_str();
       if (nominal_text == "~" || nominal_text == "{}") nominal_text.clear();
+      nominal_node = v;
     } else if (key == "effects") {
       if (!v.IsMap()) throw Error(yaml_where(source, v.Mark()) + ": effects must be a map");
       for (const auto& e : v) {
@@ -100,6 +102,17 @@ CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std:
   } else if (out.nominal_model == "full-vehicle") {
     if (!nominal_text.empty()) out.full_vehicle = full_vehicle_params_from_yaml(nominal_text, where);
     out.nominal = out.full_vehicle.base;
+  } else if (out.nominal_model == "kinematic") {
+    if (!nominal_text.empty()) out.kinematic = kinematic_bicycle_params_from_yaml(nominal_text, where);
+  } else if (out.nominal_model == "autorally-nn") {
+    if (!nominal_text.empty()) {
+      if (!nominal_node.IsMap()) throw Error(where + ": expected a map with network_npz");
+      for (const auto& kv : nominal_node) {
+        const std::string k = kv.first.as<std::string>();
+        if (k != "network_npz") throw Error(yaml_where(where, kv.first.Mark()) + ": unknown key '" + k + "' (valid: network_npz)");
+        out.network_npz = kv.second.IsNull() ? "" : kv.second.as<std::string>();
+      }
+    }
   } else if (!nominal_text.empty()) {
     out.nominal = single_track_params_from_yaml(nominal_text, where);
   }
@@ -133,6 +146,16 @@ std::string corrected_model_to_yaml(const CorrectedModelFile& m, const std::stri
   for (const auto& f : kEffectFields)
     if (m.effects.*(f.member) != defaults.*(f.member)) eff << "  " << f.key << ": " << m.effects.*(f.member) << "\n";
   o << (eff.str().empty() ? "effects: {}\n" : "effects:\n" + eff.str());
+  if (m.nominal_model == "kinematic") {
+    const KinematicBicycleParams& k = m.kinematic;
+    o << "nominal_params:\n  wheelbase_m: " << k.wheelbase_m << "\n  max_steer_rad: " << k.max_steer_rad
+      << "\n  max_accel_mps2: " << k.max_accel_mps2 << "\n  speed_damping_per_s: " << k.speed_damping_per_s << "\n";
+    return o.str();
+  }
+  if (m.nominal_model == "autorally-nn") {
+    o << "nominal_params:\n  network_npz: \"" << m.network_npz << "\"\n";
+    return o.str();
+  }
   if (m.nominal_model == "double-track" || m.nominal_model == "full-vehicle") {
     std::istringstream lines(m.nominal_model == "double-track" ? to_yaml(m.double_track) : to_yaml(m.full_vehicle));
     o << "nominal_params:\n";

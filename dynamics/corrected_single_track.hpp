@@ -231,16 +231,20 @@ class CorrectedSingleTrack {
 //   nominal_params: { <single-track keys, as in data/config/autorally_single_track.yaml> }
 //   effects: { <EffectParams field>: value, ... }
 // Unknown keys, non-numbers and invalid values throw mppi::Error naming the file and key.
-//   nominal: double-track | full-vehicle (then nominal_params holds that model's keys and the
-//   effects wrap it: WithEffects<DoubleTrack / FullVehicle>, dynamics/with_effects.hpp)
+//   nominal: double-track | full-vehicle | kinematic | autorally-nn (then nominal_params holds
+//   that model's keys, for the network `network_npz: PATH` (empty = the shipped AutoRally
+//   network), and the effects wrap it: WithEffects<...>, dynamics/with_effects.hpp)
 struct CorrectedModelFile {
-  std::string nominal_model = "single-track";  // single-track | double-track | full-vehicle
-  SingleTrackParams nominal;          // single-track: the model; otherwise the four-wheel model's core
+  std::string nominal_model = "single-track";  // one of kCorrectedNominalModels
+  SingleTrackParams nominal;          // single-track: the model; four-wheel: their core
   DoubleTrackParams double_track;     // nominal_model == "double-track"
   FullVehicleParams full_vehicle;     // nominal_model == "full-vehicle"
+  KinematicBicycleParams kinematic;   // nominal_model == "kinematic"
+  std::string network_npz;            // nominal_model == "autorally-nn" ("" = the shipped network)
   EffectParams effects;
   std::vector<std::string> selected;  // effect ids (informational, `selected:` list)
 };
+inline constexpr const char* kCorrectedNominalModels = "single-track, double-track, full-vehicle, kinematic, autorally-nn";
 CorrectedModelFile load_corrected_model(const std::string& path);
 CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std::string& source);
 // YAML text of a corrected-model file.

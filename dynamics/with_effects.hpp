@@ -1,15 +1,19 @@
 #pragma once
-// "Nominal + effects" for the four-wheel models: WithEffects<DoubleTrack> and
-// WithEffects<FullVehicle> add the terms that `mppi-fit diagnose` names (the EffectParams of
-// dynamics/corrected_single_track.hpp) around an unchanged base model, so that a diagnosis can
-// start from any of the library's tyre models. The single-track model has its own exact class
-// (CorrectedSingleTrack, effects inside its force balance); here they enter around the base:
+// "Nominal + effects" around any other model of the library: WithEffects<DoubleTrack>,
+// <FullVehicle>, <KinematicBicycle>, <AutoRallyNetwork> add the terms that `mppi-fit diagnose`
+// names (the EffectParams of dynamics/corrected_single_track.hpp) around an unchanged base
+// model, so that a diagnosis can start from any of them. The single-track model has its own
+// exact class (CorrectedSingleTrack, effects inside its force balance); here they enter around
+// the base:
 //   - actuator effects (offsets, gain, delays, lags, voltage sag) transform the command first;
 //   - tyre effects (tire_saturation, friction_change, load_transfer) change the base's
 //     single-track core parameters (apply_effect_params), with a second base model for the grip
-//     after a change (time is a state);
+//     after a change (time is a state). Only for bases with such a core (the four-wheel
+//     models); the kinematic bicycle and the network have no tyres, so these are refused;
 //   - force effects (aero_drag, rolling_resistance, road_grade) add their acceleration to
-//     v_x / v_y after the base step (operator splitting; the step is the plant's 2 ms).
+//     v_x (and v_y where the base has a lateral velocity) after the base step (operator
+//     splitting; the step is the plant's 2 ms). Mass: the base's own, or for bases without one
+//     the AutoRally car's (SingleTrackParams defaults; the network models that car).
 // State: the base's kNx, then time [s], then the steer and throttle actuator chains.
 #include <algorithm>
 #include <array>
@@ -18,45 +22,57 @@
 #include <type_traits>
 #include <utility>
 
+#include "dynamics/autorally_nn.hpp"
 #include "dynamics/corrected_single_track.hpp"
 #include "dynamics/double_track.hpp"
 #include "dynamics/full_vehicle.hpp"
+#include "dynamics/kinematic_bicycle.hpp"
 #include "mppi/concepts.hpp"
 
 namespace mppi {
 
+// A base whose parameters hold a single-track core (mass, tyres, CG height): tyre effects apply.
 template <class Base>
-concept FourWheelBase = VehicleDynamics<Base> && requires(const Base& b) {
+concept HasSingleTrackCore = requires(const Base& b) {
   { b.params().base } -> std::convertible_to<SingleTrackParams>;
 };
 
-template <FourWheelBase Base>
+template <VehicleDynamics Base>
 class WithEffects {
  public:
-  using Params = std::decay_t<decltype(std::declval<const Base&>().params())>;
+  static constexpr bool kTyreEffects = HasSingleTrackCore<Base>;
+  static constexpr bool kLateralVelocity = !std::is_same_v<Base, KinematicBicycle>;  // it pins v_y = 0
   static constexpr int kChain = CorrectedSingleTrack::kChain;
   static constexpr int kTime = Base::kNx;
   static constexpr int kSteerChain = kTime + 1;
   static constexpr int kThrottleChain = kSteerChain + kChain;
   static constexpr int kNx = kThrottleChain + kChain;
   static constexpr int kNu = 2;
-  static constexpr int kOmega = Base::kOmega;  // wheel speeds, as in the base
+  static constexpr int kOmega = [] {  // wheel speeds, as in the base (-1: none)
+    if constexpr (requires { Base::kOmega; }) return Base::kOmega;
+    else return -1;
+  }();
 
-  // Throws mppi::Error if the parameters are not valid (nominal, effects, or the combination).
-  explicit WithEffects(const Params& nominal = {}, const EffectParams& effects = {})
+  // Throws mppi::Error if the effects are not valid, make the base invalid, or need tyres the
+  // base does not have.
+  explicit WithEffects(const Base& nominal, const EffectParams& effects = {})
       : nominal_(nominal), effects_(validated(effects)), before_(with_core(nominal, effects, 1.0)),
         after_(with_core(nominal, effects, effects.grip_scale)) {
-    const double m = nominal_.base.mass_kg;
+    double m = SingleTrackParams{}.mass_kg, g = SingleTrackParams{}.gravity_mps2;
+    if constexpr (kTyreEffects) {
+      m = nominal_.params().base.mass_kg;
+      g = nominal_.params().base.gravity_mps2;
+    }
     drag_per_kg_ = static_cast<float>(effects_.aero_drag_kgpm / m);
     roll_per_kg_ = static_cast<float>(effects_.rolling_force_N / m);
     visc_per_kg_ = static_cast<float>(effects_.rolling_viscous_Nspm / m);
-    grade_x_ = static_cast<float>(nominal_.base.gravity_mps2 * effects_.grade_x);
-    grade_y_ = static_cast<float>(nominal_.base.gravity_mps2 * effects_.grade_y);
+    grade_x_ = static_cast<float>(g * effects_.grade_x);
+    grade_y_ = static_cast<float>(g * effects_.grade_y);
     change_time_ = static_cast<float>(effects_.grip_change_time_s);
     grip_changes_ = effects_.grip_scale != 1.0;
   }
 
-  const Params& nominal() const { return nominal_; }
+  const Base& nominal() const { return nominal_; }
   const EffectParams& effects() const { return effects_; }
   std::size_t scratch_floats(int w) const { return before_.scratch_floats(w); }
 
@@ -115,7 +131,7 @@ class WithEffects {
                        (grade_x_ * cy + grade_y_ * sy);
       const float ay = -(-grade_x_ * sy + grade_y_ * cy);
       x[state::kVx][j] += ax * dt_s;
-      x[state::kVy][j] += ay * dt_s;
+      if constexpr (kLateralVelocity) x[state::kVy][j] += ay * dt_s;
       x[kTime][j] += dt_s;
     }
   }
@@ -133,9 +149,17 @@ class WithEffects {
   }
 
  private:
-  static Params with_core(Params p, const EffectParams& e, double grip) {
-    p.base = apply_effect_params(p.base, e, grip);
-    return p;
+  static Base with_core(const Base& b, const EffectParams& e, double grip) {
+    if constexpr (kTyreEffects) {
+      auto p = b.params();
+      p.base = apply_effect_params(p.base, e, grip);
+      return Base(p);
+    } else {
+      if (e.tyre_peak_scale != 1.0 || e.tyre_stiffness_scale != 1.0 || e.grip_scale != 1.0 || e.cg_height_delta_m != 0.0)
+        throw Error("WithEffects: tire_saturation, friction_change and load_transfer need a tyre model; this base "
+                    "model has none");
+      return b;
+    }
   }
   static const EffectParams& validated(const EffectParams& e) {
     std::string why;
@@ -143,7 +167,7 @@ class WithEffects {
     return e;
   }
 
-  Params nominal_;
+  Base nominal_;
   EffectParams effects_;
   Base before_, after_;
   float drag_per_kg_ = 0, roll_per_kg_ = 0, visc_per_kg_ = 0, grade_x_ = 0, grade_y_ = 0, change_time_ = 0;
@@ -152,5 +176,7 @@ class WithEffects {
 
 using DoubleTrackWithEffects = WithEffects<DoubleTrack>;
 using FullVehicleWithEffects = WithEffects<FullVehicle>;
+using KinematicWithEffects = WithEffects<KinematicBicycle>;
+using AutoRallyNetworkWithEffects = WithEffects<AutoRallyNetwork>;
 
 }  // namespace mppi

@@ -35,7 +35,7 @@
 namespace mppi::sim {
 namespace {
 
-constexpr const char* kDefaultNetwork = "autorally/models/autorally_nnet_09_12_2018.npz";
+constexpr const char* kDefaultNetwork = kDefaultNetworkFile;
 constexpr const char* kDefaultCostYaml = "config/autorally_cost.yaml";
 constexpr const char* kDefaultSingleTrackYaml = "config/autorally_single_track.yaml";
 constexpr const char* kDefaultDoubleTrackYaml = "config/autorally_double_track.yaml";
@@ -152,16 +152,41 @@ ControllerSetup make_controller(const ClosedLoopConfig& config, const AutoRallyC
     // Nominal + fitted effects (mppi-fit diagnose); a corrected plant shares its state layout.
     if (config.model_params_yaml.empty()) throw Error("--model corrected needs --model-params FILE");
     const CorrectedModelFile file = load_corrected_model(config.model_params_yaml);
+    if (file.nominal_model == "kinematic" || file.nominal_model == "autorally-nn") {
+      // The other models + effects: read like their base (common states), chains at rest.
+      const auto observe_common = [](int model_states) {
+        return [model_states](const float* px, int plant_states, float* mx) {
+          if (plant_states == model_states) {
+            std::copy(px, px + model_states, mx);
+            return;
+          }
+          std::fill(mx, mx + model_states, 0.f);
+          std::copy(px, px + state::kCommonStates, mx);
+        };
+      };
+      if (file.nominal_model == "kinematic") {
+        const KinematicWithEffects model(KinematicBicycle(file.kinematic), file.effects);
+        setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
+        setup.model_states = KinematicWithEffects::kNx;
+      } else {
+        const AutoRallyNetworkWithEffects model(
+            AutoRallyNetwork::load(file.network_npz.empty() ? data_file(kDefaultNetwork) : file.network_npz), file.effects);
+        setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
+        setup.model_states = AutoRallyNetworkWithEffects::kNx;
+      }
+      setup.observe = observe_common(setup.model_states);
+      return setup;
+    }
     if (file.nominal_model == "double-track" || file.nominal_model == "full-vehicle") {
       // Four-wheel nominal + effects (dynamics/with_effects.hpp).
       const float radius = static_cast<float>(file.nominal.wheel_radius_m);
       if (file.nominal_model == "double-track") {
-        const DoubleTrackWithEffects model(file.double_track, file.effects);
+        const DoubleTrackWithEffects model(DoubleTrack(file.double_track), file.effects);
         setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
         setup.model_states = DoubleTrackWithEffects::kNx;
         setup.observe = observe_four_wheel<DoubleTrackWithEffects>(radius);
       } else {
-        const FullVehicleWithEffects model(file.full_vehicle, file.effects);
+        const FullVehicleWithEffects model(FullVehicle(file.full_vehicle), file.effects);
         setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
         setup.model_states = FullVehicleWithEffects::kNx;
         setup.observe = observe_four_wheel<FullVehicleWithEffects>(radius);
@@ -385,9 +410,18 @@ RunSummary run_closed_loop(const ClosedLoopConfig& config) {
     if (config.plant_params_yaml.empty()) throw Error("--plant corrected needs --plant-params FILE");
     const CorrectedModelFile file = load_corrected_model(config.plant_params_yaml);
     if (file.nominal_model == "double-track")
-      return run_with_plant(config, DoubleTrackWithEffects(file.double_track, file.effects), track, cost);
+      return run_with_plant(config, DoubleTrackWithEffects(DoubleTrack(file.double_track), file.effects), track, cost);
     if (file.nominal_model == "full-vehicle")
-      return run_with_plant(config, FullVehicleWithEffects(file.full_vehicle, file.effects), track, cost);
+      return run_with_plant(config, FullVehicleWithEffects(FullVehicle(file.full_vehicle), file.effects), track, cost);
+    if (file.nominal_model == "kinematic")
+      return run_with_plant(config, KinematicWithEffects(KinematicBicycle(file.kinematic), file.effects), track, cost);
+    if (file.nominal_model == "autorally-nn")
+      return run_with_plant(config,
+                            AutoRallyNetworkWithEffects(AutoRallyNetwork::load(file.network_npz.empty()
+                                                                                   ? data_file(kDefaultNetwork)
+                                                                                   : file.network_npz),
+                                                        file.effects),
+                            track, cost);
     return run_with_plant(config, CorrectedSingleTrack(file.nominal, file.effects), track, cost);
   }
   throw Error("unknown plant '" + config.plant +

@@ -12,4 +12,7 @@ std::string data_dir();
 // data_dir() + "/" + relative. Throws mppi::Error naming the full path if the file is missing.
 std::string data_file(const std::string& relative);
 
+// The shipped AutoRally network (data/autorally/models), relative to the data folder.
+inline constexpr const char* kDefaultNetworkFile = "autorally/models/autorally_nnet_09_12_2018.npz";
+
 }  // namespace mppi::sim

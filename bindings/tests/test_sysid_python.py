@@ -235,8 +235,8 @@ def test_diagnose_clean_recording_names_nothing(tmp_path):
     with pytest.raises(mppi.Error, match="no_such_effect"):
         mppi.diagnose(path, effects=["no_such_effect"])
     # A nominal model without an effects version is refused by name.
-    with pytest.raises(mppi.Error, match="autorally-nn"):
-        mppi.diagnose(path, model="autorally-nn")
+    with pytest.raises(mppi.Error, match="diff-drive"):
+        mppi.diagnose(path, model="diff-drive")
     # The double-track nominal on a single-track recording: runs, reports its model.
     r = mppi.diagnose(path, model="double-track", effects=["steer_delay"])
     assert r["report"]["model"] == "double-track"

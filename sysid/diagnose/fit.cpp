@@ -184,10 +184,16 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal,
   const double n_eff = n_fit / opt.samples_per_independent;
 
   std::vector<const EffectSpec*> cands;
-  if (opt.candidates.empty())
-    for (const auto& e : effect_library()) cands.push_back(&e);
-  else
-    for (const auto& id : opt.candidates) cands.push_back(&effect_spec(id));
+  if (opt.candidates.empty()) {
+    for (const auto& e : effect_library())
+      if (nominal.supports(e.id)) cands.push_back(&e);
+  } else {
+    for (const auto& id : opt.candidates) {
+      if (!nominal.supports(id))
+        throw Error("effect '" + id + "' needs a tyre model; the nominal " + nominal.name() + " has none");
+      cands.push_back(&effect_spec(id));
+    }
+  }
 
   const double held_nominal = heldout_1s_normalized_rmse(*nominal.make({}), d, heldout_mask, replay);
   EffectParams base;

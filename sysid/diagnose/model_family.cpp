@@ -5,6 +5,7 @@
 
 #include "dynamics/with_effects.hpp"
 #include "mppi/error.hpp"
+#include "sim/data_dir.hpp"
 
 namespace mppi::diagnose {
 namespace {
@@ -12,9 +13,8 @@ namespace {
 template <class M>
 class ReplayModelOf final : public ReplayModel {
  public:
-  explicit ReplayModelOf(M m) : m_(std::move(m)) {
+  explicit ReplayModelOf(M m) : m_(std::move(m)), scratch_(m_.scratch_floats(1)) {
     static_assert(M::kNx <= kMaxStates, "raise ReplayModel::kMaxStates");
-    if (m_.scratch_floats(1) != 0) throw Error("ReplayModel: models that need scratch memory are not supported");
   }
   int states() const override { return M::kNx; }
   int time_index() const override { return M::kTime; }
@@ -25,11 +25,12 @@ class ReplayModelOf final : public ReplayModel {
   }
   void step(float* x, float steer, float throttle, float dt_s) const override {
     const float u[2] = {steer, throttle};
-    m_.template step<1>(Batch<M::kNx, 1>{x}, ConstBatch<2, 1>{u}, dt_s, nullptr);
+    m_.template step<1>(Batch<M::kNx, 1>{x}, ConstBatch<2, 1>{u}, dt_s, scratch_.data());
   }
 
  private:
   M m_;
+  mutable std::vector<float> scratch_;  // the model's per-step work space (the network's layers)
 };
 
 class SingleTrackFamily final : public ModelFamily {
@@ -52,29 +53,31 @@ class SingleTrackFamily final : public ModelFamily {
   std::string name_ = "single-track";
 };
 
+// Any other base: WithEffects<Base> around the nominal model; `file` carries its parameters.
 template <class Base>
-class FourWheelFamily final : public ModelFamily {
+class WrappedFamily final : public ModelFamily {
  public:
-  using Params = typename WithEffects<Base>::Params;
-  FourWheelFamily(const Params& p, std::string name) : p_(p), name_(std::move(name)) { WithEffects<Base> check(p_); }
-  const std::string& name() const override { return name_; }
+  WrappedFamily(Base nominal, CorrectedModelFile file) : nominal_(std::move(nominal)), file_(std::move(file)) {
+    WithEffects<Base> check(nominal_);
+  }
+  const std::string& name() const override { return file_.nominal_model; }
   std::unique_ptr<ReplayModel> make(const EffectParams& e) const override {
-    return std::make_unique<ReplayModelOf<WithEffects<Base>>>(WithEffects<Base>(p_, e));
+    return std::make_unique<ReplayModelOf<WithEffects<Base>>>(WithEffects<Base>(nominal_, e));
+  }
+  bool supports(const std::string& effect_id) const override {
+    return WithEffects<Base>::kTyreEffects ||
+           (effect_id != "tire_saturation" && effect_id != "friction_change" && effect_id != "load_transfer");
   }
   CorrectedModelFile file(const EffectParams& e, const std::vector<std::string>& selected) const override {
-    CorrectedModelFile f;
-    f.nominal_model = name_;
-    f.nominal = p_.base;
-    if constexpr (std::is_same_v<Base, DoubleTrack>) f.double_track = p_;
-    else f.full_vehicle = p_;
+    CorrectedModelFile f = file_;
     f.effects = e;
     f.selected = selected;
     return f;
   }
 
  private:
-  Params p_;
-  std::string name_;
+  Base nominal_;
+  CorrectedModelFile file_;
 };
 
 std::string read_text(const std::string& path) {
@@ -87,18 +90,32 @@ std::string read_text(const std::string& path) {
 
 }  // namespace
 
-std::unique_ptr<ModelFamily> model_family_of(const CorrectedModelFile& f) {
-  if (f.nominal_model == "double-track") return std::make_unique<FourWheelFamily<DoubleTrack>>(f.double_track, f.nominal_model);
-  if (f.nominal_model == "full-vehicle") return std::make_unique<FourWheelFamily<FullVehicle>>(f.full_vehicle, f.nominal_model);
+std::unique_ptr<ModelFamily> model_family_of(const CorrectedModelFile& file) {
+  CorrectedModelFile f = file;
+  f.effects = {};
+  f.selected.clear();
+  if (f.nominal_model == "double-track") return std::make_unique<WrappedFamily<DoubleTrack>>(DoubleTrack(f.double_track), f);
+  if (f.nominal_model == "full-vehicle") return std::make_unique<WrappedFamily<FullVehicle>>(FullVehicle(f.full_vehicle), f);
+  if (f.nominal_model == "kinematic")
+    return std::make_unique<WrappedFamily<KinematicBicycle>>(KinematicBicycle(f.kinematic), f);
+  if (f.nominal_model == "autorally-nn")
+    return std::make_unique<WrappedFamily<AutoRallyNetwork>>(
+        AutoRallyNetwork::load(f.network_npz.empty() ? sim::data_file(sim::kDefaultNetworkFile) : f.network_npz), f);
+  if (f.nominal_model != "single-track")
+    throw Error("nominal model '" + f.nominal_model + "' cannot be diagnosed (valid: " + kCorrectedNominalModels + ")");
   return std::make_unique<SingleTrackFamily>(f.nominal);
 }
 
 std::unique_ptr<ModelFamily> make_model_family(const std::string& model, const std::string& params_path) {
-  if (model != "single-track" && model != "double-track" && model != "full-vehicle")
-    throw Error("nominal model '" + model + "' cannot be diagnosed (valid: " + kDiagnoseModels + ")");
+  if (model != "single-track" && model != "double-track" && model != "full-vehicle" && model != "kinematic" &&
+      model != "autorally-nn")
+    throw Error("nominal model '" + model + "' cannot be diagnosed (valid: " + kCorrectedNominalModels + ")");
   CorrectedModelFile f;
   f.nominal_model = model;
-  if (!params_path.empty()) {
+  if (model == "autorally-nn" && !params_path.empty() && params_path.size() > 4 &&
+      params_path.substr(params_path.size() - 4) == ".npz") {
+    f.network_npz = params_path;  // the network's weights
+  } else if (!params_path.empty()) {
     const std::string text = read_text(params_path);
     if (text.find("nominal_params") != std::string::npos) {  // a corrected-model file: its nominal part
       f = corrected_model_from_yaml(text, params_path);
@@ -108,6 +125,8 @@ std::unique_ptr<ModelFamily> make_model_family(const std::string& model, const s
       f.double_track = double_track_params_from_yaml(text, params_path);
     } else if (model == "full-vehicle") {
       f.full_vehicle = full_vehicle_params_from_yaml(text, params_path);
+    } else if (model == "kinematic") {
+      f.kinematic = kinematic_bicycle_params_from_yaml(text, params_path);
     } else {
       f.nominal = single_track_params_from_yaml(text, params_path);
     }

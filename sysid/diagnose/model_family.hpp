@@ -1,7 +1,8 @@
 #pragma once
 // The nominal model a diagnosis starts from, as a family of "nominal + effects" models: one
 // member per set of effect values. Single-track (CorrectedSingleTrack, every effect inside its
-// force balance), double-track and full-vehicle (WithEffects<...>, dynamics/with_effects.hpp).
+// force balance); double-track, full-vehicle, kinematic and the AutoRally network
+// (WithEffects<...>, dynamics/with_effects.hpp; tyre effects only where there are tyres).
 // The replay and the fits see a member through ReplayModel: one state vector, stepped one
 // sample at a time (offline work, so a virtual call per step is fine here).
 #include <memory>
@@ -27,22 +28,22 @@ class ReplayModel {
 class ModelFamily {
  public:
   virtual ~ModelFamily() = default;
-  virtual const std::string& name() const = 0;  // single-track | double-track | full-vehicle
+  virtual const std::string& name() const = 0;  // one of kCorrectedNominalModels
   // The member with these effects; throws mppi::Error where the values make the model invalid.
   virtual std::unique_ptr<ReplayModel> make(const EffectParams& effects) const = 0;
+  // Whether the candidate effect exists for this base (tyre effects need a tyre model).
+  virtual bool supports(const std::string& effect_id) const { (void)effect_id; return true; }
   // The corrected-model file of a member (corrected_model_to_yaml's input).
   virtual CorrectedModelFile file(const EffectParams& effects, const std::vector<std::string>& selected) const = 0;
 };
 
-// "single-track" | "double-track" | "full-vehicle" with parameters from `params_path` (that
-// model's YAML, or a corrected-model file whose nominal part is used; empty = the library
-// defaults). Throws mppi::Error naming the model or file.
+// One of kCorrectedNominalModels with parameters from `params_path`: that model's YAML (for
+// autorally-nn the network's .npz), or a corrected-model file whose nominal part is used; empty
+// = the library defaults. Throws mppi::Error naming the model or file.
 std::unique_ptr<ModelFamily> make_model_family(const std::string& model, const std::string& params_path = "");
 
 // The family of a corrected-model file's nominal model (its effects are ignored).
 std::unique_ptr<ModelFamily> model_family_of(const CorrectedModelFile& file);
 
-// The models a diagnosis can start from, for messages.
-inline constexpr const char* kDiagnoseModels = "single-track, double-track, full-vehicle";
 
 }  // namespace mppi::diagnose

@@ -11,9 +11,11 @@
 #include "mppi/error.hpp"
 #include "dynamics/with_effects.hpp"
 #include "sim/closed_loop.hpp"
+#include "sim/data_dir.hpp"
 #include "sim/plant.hpp"
 #include "sim/recording.hpp"
 #include "sysid/diagnose/effects.hpp"
+#include "sysid/diagnose/model_family.hpp"
 
 namespace mppi::diagnose {
 
@@ -116,9 +118,15 @@ sim::Recording drive_open_loop(M truth_model, std::uint64_t seed, double duratio
 sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t seed, double duration_s,
                                     const SensorNoise& noise, const std::string& nominal_model) {
   if (nominal_model == "double-track")
-    return drive_open_loop(DoubleTrackWithEffects(DoubleTrackParams{}, truth), seed, duration_s, noise);
+    return drive_open_loop(DoubleTrackWithEffects(DoubleTrack(), truth), seed, duration_s, noise);
   if (nominal_model == "full-vehicle")
-    return drive_open_loop(FullVehicleWithEffects(FullVehicleParams{}, truth), seed, duration_s, noise);
+    return drive_open_loop(FullVehicleWithEffects(FullVehicle(), truth), seed, duration_s, noise);
+  if (nominal_model == "kinematic")
+    return drive_open_loop(KinematicWithEffects(KinematicBicycle(), truth), seed, duration_s, noise);
+  if (nominal_model == "autorally-nn")
+    return drive_open_loop(
+        AutoRallyNetworkWithEffects(AutoRallyNetwork::load(sim::data_file(sim::kDefaultNetworkFile)), truth), seed,
+        duration_s, noise);
   if (nominal_model != "single-track")
     throw Error("synthesize_open_loop: unknown nominal model '" + nominal_model + "'");
   return drive_open_loop(CorrectedSingleTrack(SingleTrackParams{}, truth), seed, duration_s, noise);
@@ -139,8 +147,11 @@ std::vector<std::pair<double, double>> speed_schedule(std::uint64_t seed, double
 int synthesize(const SynthOptions& o, const std::string& csv_path) {
   if (o.work_dir.empty()) throw Error("synthesize: work_dir is required");
   std::filesystem::create_directories(o.work_dir);
-  if (o.nominal_model != "single-track" && o.nominal_model != "double-track" && o.nominal_model != "full-vehicle")
-    throw Error("synthesize: unknown nominal model '" + o.nominal_model + "'");
+  model_family_of([&] {  // throws for a model without an effects version
+    CorrectedModelFile f;
+    f.nominal_model = o.nominal_model;
+    return f;
+  }());
   CorrectedModelFile truth;
   truth.nominal_model = o.nominal_model;
   truth.effects = o.truth;

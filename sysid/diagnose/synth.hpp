@@ -24,8 +24,8 @@ struct SensorNoise {
 
 struct SynthOptions {
   EffectParams truth;                 // hidden effects (defaults = none)
-  // The truth's base model (library defaults): single-track | double-track | full-vehicle. The
-  // driver (MPPI) uses the same model without the effects.
+  // The truth's base model (library defaults), one of kCorrectedNominalModels. The driver
+  // (MPPI) uses the same model without the effects.
   std::string nominal_model = "single-track";
   std::vector<std::string> truth_ids; // their ids, written to the metadata
   std::uint64_t seed = 1;             // MPPI and noise seed
@@ -60,8 +60,8 @@ int synthesize(const SynthOptions& o, const std::string& csv_path);
 // A fast open-loop variant for tests: the truth plant (500 Hz, no slew limits) driven on open
 // ground by random steering and throttle (held 0.1-0.5 s, speed kept in about 3-9 m/s), logged at
 // 50 Hz with sensor noise, in the recording format (metadata source "mppi-fit synth").
-// nominal_model: the truth's base, "single-track" (CorrectedSingleTrack), "double-track" or
-// "full-vehicle" (WithEffects<...>), each with the library's default parameters.
+// nominal_model: the truth's base, "single-track" (CorrectedSingleTrack), or "double-track",
+// "full-vehicle", "kinematic", "autorally-nn" (WithEffects<...>), with the library's defaults.
 sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t seed, double duration_s,
                                     const SensorNoise& noise = {}, const std::string& nominal_model = "single-track");
 
