@@ -22,6 +22,7 @@ DiagData prepare(const sim::Recording& rec, const std::string& source, std::size
   d.r = rec.column("yaw_rate");
   d.steer = rec.column("steer");
   d.throttle = rec.column("throttle");
+  if (rec.has_column("roll")) d.roll = rec.column("roll");
   const auto src = rec.metadata.find("source");
   d.control_lead = (src != rec.metadata.end() &&
                     (src->second == "mppi-sim" || src->second.rfind("mppi-fit synth", 0) == 0))
@@ -91,6 +92,8 @@ DiagData concat(const DiagData& a, const DiagData& b) {
   append(d.r, b.r, 0);
   append(d.steer, b.steer, 0);
   append(d.throttle, b.throttle, 0);
+  if (!a.roll.empty() && !b.roll.empty()) append(d.roll, b.roll, 0);
+  else d.roll.clear();  // roll only where both recordings have it
   for (int p : b.piece) d.piece.push_back(p < 0 ? -1 : p + max_piece + 1);
   return d;
 }

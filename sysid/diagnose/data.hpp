@@ -16,6 +16,9 @@ inline const char* const kChannelUnits[kChannels] = {"m/s", "m/s", "rad/s"};
 struct DiagData {
   std::string source;                       // file name, for messages
   std::vector<double> t, x, y, yaw, vx, vy, r, steer, throttle;
+  // Optional `roll` column [rad] (empty when the recording has none): the start state of
+  // models that carry roll (the AutoRally network takes it as an input).
+  std::vector<double> roll;
   // The command that acts over (t[k], t[k+1]]: index k + control_lead. mppi-sim logs hold in
   // row k+1 the command that produced it (lead 1); real recordings the command sent at t[k] (0).
   int control_lead = 0;

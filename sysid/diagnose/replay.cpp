@@ -36,6 +36,8 @@ void predict_segment(const ReplayModel& model, const DiagData& d, const Segment&
   vs.vx_mps = static_cast<float>(d.vx[k0]);
   vs.vy_mps = static_cast<float>(d.vy[k0]);
   vs.yaw_rate_radps = static_cast<float>(d.r[k0]);
+  const bool has_roll = !d.roll.empty() && std::isfinite(d.roll[k0]);
+  if (has_roll) vs.roll_rad = static_cast<float>(d.roll[k0]);
   model.init_state(vs, x);
   const int time_state = model.time_index();
   x[time_state] = static_cast<float>(d.t[k0]);
@@ -57,6 +59,7 @@ void predict_segment(const ReplayModel& model, const DiagData& d, const Segment&
     x[state::kVx] += g * (static_cast<float>(d.vx[k]) - x[state::kVx]);
     x[state::kVy] += g * (static_cast<float>(d.vy[k]) - x[state::kVy]);
     x[state::kYawRate] += g * (static_cast<float>(d.r[k]) - x[state::kYawRate]);
+    if (has_roll && std::isfinite(d.roll[k])) x[state::kRoll] += g * (static_cast<float>(d.roll[k]) - x[state::kRoll]);
     x[time_state] = static_cast<float>(d.t[k]);
   };
   float u[2];

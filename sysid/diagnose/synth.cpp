@@ -85,6 +85,11 @@ sim::Recording drive_open_loop(M truth_model, std::uint64_t seed, double duratio
   sim::Recording rec;
   rec.metadata = {{"source", "mppi-fit synth (open loop)"}, {"seed", std::to_string(seed)}};
   rec.columns = {sim::kRecordingRequiredColumns.begin(), sim::kRecordingRequiredColumns.end()};
+  rec.columns.push_back("roll");
+  // Its own stream and distribution (normal_distribution caches draws): the other draws stay as
+  // they were without the roll column.
+  std::mt19937_64 roll_rng(seed * 6007 + 29);
+  std::normal_distribution<double> roll_n01(0.0, noise.scale);
   rec.data.assign(rec.columns.size(), {});
   Control cmd;
   double hold = 0;
@@ -107,7 +112,8 @@ sim::Recording drive_open_loop(M truth_model, std::uint64_t seed, double duratio
                           s.vy_mps + noise.vy_mps * n01(rng),
                           s.yaw_rate_radps + noise.yaw_rate_radps * n01(rng),
                           cmd.steer,
-                          cmd.throttle};
+                          cmd.throttle,
+                          s.roll_rad + noise.roll_rad * roll_n01(roll_rng)};
     for (std::size_t c = 0; c < rec.columns.size(); ++c) rec.data[c].push_back(row[c]);
   }
   return rec;
@@ -195,7 +201,11 @@ int synthesize(const SynthOptions& o, const std::string& csv_path) {
   std::normal_distribution<double> n01(0.0, o.noise.scale);
   std::string ids;
   for (const auto& id : o.truth_ids) ids += (ids.empty() ? "" : " ") + id;
-  sim::RecordingWriter w(csv_path, {"applied_steer", "applied_throttle"},
+  // Roll (an optional column) gets noise from its own stream, so the other columns' noise is
+  // the same as without it.
+  std::mt19937_64 roll_rng(o.seed * 6007 + 29);
+  std::normal_distribution<double> roll_n01(0.0, o.noise.scale);
+  sim::RecordingWriter w(csv_path, {"applied_steer", "applied_throttle", "roll"},
                          {{"source", "mppi-fit synth"}, {"track", o.track}, {"seed", std::to_string(o.seed)},
                           {"truth_effects", ids.empty() ? "none" : ids},
                           {"truth_model", truth_path},
@@ -212,6 +222,7 @@ int synthesize(const SynthOptions& o, const std::string& csv_path) {
   const auto& th = raw.column("throttle");
   const auto& ast = raw.column("applied_steer");
   const auto& ath = raw.column("applied_throttle");
+  const auto& roll = raw.column("roll");
   for (std::size_t k = 0; k < raw.rows(); ++k) {
     const double row[] = {t[k],
                           x[k] + o.noise.position_m * n01(rng),
@@ -220,7 +231,7 @@ int synthesize(const SynthOptions& o, const std::string& csv_path) {
                           vx[k] + o.noise.vx_mps * n01(rng),
                           vy[k] + o.noise.vy_mps * n01(rng),
                           r[k] + o.noise.yaw_rate_radps * n01(rng),
-                          st[k], th[k], ast[k], ath[k]};
+                          st[k], th[k], ast[k], ath[k], roll[k] + o.noise.roll_rad * roll_n01(roll_rng)};
     w.write_row(row);
   }
   w.close();

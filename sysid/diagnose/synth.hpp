@@ -19,6 +19,7 @@ struct SensorNoise {
   double vx_mps = 0.05;
   double vy_mps = 0.03;
   double yaw_rate_radps = 0.02; // gyro
+  double roll_rad = 0.005;      // the optional roll column (drawn from its own stream)
   double scale = 1.0;           // multiplies all of the above (0 = noise-free)
 };
 
