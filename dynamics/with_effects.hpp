@@ -25,8 +25,10 @@
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/corrected_single_track.hpp"
 #include "dynamics/double_track.hpp"
+#include "dynamics/fast_trig.hpp"
 #include "dynamics/full_vehicle.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
+#include "dynamics/pacejka.hpp"
 #include "mppi/concepts.hpp"
 
 namespace mppi {
@@ -126,8 +128,9 @@ class WithEffects {
     }
     for (int j = 0; j < W; ++j) {
       const float vx = vx0[j];
-      const float sy = std::sin(yaw0[j]), cy = std::cos(yaw0[j]);
-      const float ax = -drag_per_kg_ * vx * std::abs(vx) - roll_per_kg_ * std::tanh(vx * 2.f) - visc_per_kg_ * vx -
+      float sy, cy;
+      fast_sincos(yaw0[j], &sy, &cy);
+      const float ax = -drag_per_kg_ * vx * std::abs(vx) - roll_per_kg_ * phys::tanh(vx * 2.f) - visc_per_kg_ * vx -
                        (grade_x_ * cy + grade_y_ * sy);
       const float ay = -(-grade_x_ * sy + grade_y_ * cy);
       x[state::kVx][j] += ax * dt_s;
