@@ -60,10 +60,9 @@ CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std:
         throw Error(yaml_where(source, v.Mark()) + ": model must be 'corrected'");
     } else if (key == "nominal") {
       out.nominal_model = v.as<std::string>();
-      const std::string& n = out.nominal_model;
-      if (n != "single-track" && n != "double-track" && n != "full-vehicle" && n != "kinematic" && n != "autorally-nn")
+      if (!is_corrected_nominal_model(out.nominal_model))
         throw Error(yaml_where(source, v.Mark()) + ": nominal must be one of " + kCorrectedNominalModels + ", got '" +
-                    n + "'");
+                    out.nominal_model + "'");
     } else if (key == "nominal_params") {
       YAML::Emitter em;
       em << v;

@@ -245,6 +245,10 @@ struct CorrectedModelFile {
   std::vector<std::string> selected;  // effect ids (informational, `selected:` list)
 };
 inline constexpr const char* kCorrectedNominalModels = "single-track, double-track, full-vehicle, kinematic, autorally-nn";
+inline bool is_corrected_nominal_model(const std::string& name) {
+  return name == "single-track" || name == "double-track" || name == "full-vehicle" || name == "kinematic" ||
+         name == "autorally-nn";
+}
 CorrectedModelFile load_corrected_model(const std::string& path);
 CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std::string& source);
 // YAML text of a corrected-model file.

@@ -35,7 +35,6 @@
 namespace mppi::sim {
 namespace {
 
-constexpr const char* kDefaultNetwork = kDefaultNetworkFile;
 constexpr const char* kDefaultCostYaml = "config/autorally_cost.yaml";
 constexpr const char* kDefaultSingleTrackYaml = "config/autorally_single_track.yaml";
 constexpr const char* kDefaultDoubleTrackYaml = "config/autorally_double_track.yaml";
@@ -102,8 +101,7 @@ ControllerSetup make_controller(const ClosedLoopConfig& config, const AutoRallyC
     std::copy(px, px + state::kCommonStates, mx);
   };
   if (config.model == "autorally-nn") {
-    auto model = AutoRallyNetwork::load(config.network_npz.empty() ? data_file(kDefaultNetwork)
-                                                                   : config.network_npz);
+    auto model = AutoRallyNetwork::load(network_file_or_default(config.network_npz));
     setup.controller = build_controller(config, model, cost);
     setup.model_states = AutoRallyNetwork::kNx;
     setup.observe = copy_common;
@@ -170,7 +168,7 @@ ControllerSetup make_controller(const ClosedLoopConfig& config, const AutoRallyC
         setup.model_states = KinematicWithEffects::kNx;
       } else {
         const AutoRallyNetworkWithEffects model(
-            AutoRallyNetwork::load(file.network_npz.empty() ? data_file(kDefaultNetwork) : file.network_npz), file.effects);
+            AutoRallyNetwork::load(network_file_or_default(file.network_npz)), file.effects);
         setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
         setup.model_states = AutoRallyNetworkWithEffects::kNx;
       }
@@ -398,8 +396,7 @@ RunSummary run_closed_loop(const ClosedLoopConfig& config) {
     return run_with_plant(config, SingleTrack(single_track_params(config.plant_params_yaml)), track, cost);
   if (config.plant == "autorally-nn")
     return run_with_plant(config,
-                          AutoRallyNetwork::load(config.network_npz.empty() ? data_file(kDefaultNetwork)
-                                                                            : config.network_npz),
+                          AutoRallyNetwork::load(network_file_or_default(config.network_npz)),
                           track, cost);
   if (config.plant == "kinematic") return run_with_plant(config, KinematicBicycle(), track, cost);
   if (config.plant == "double-track")
@@ -417,9 +414,7 @@ RunSummary run_closed_loop(const ClosedLoopConfig& config) {
       return run_with_plant(config, KinematicWithEffects(KinematicBicycle(file.kinematic), file.effects), track, cost);
     if (file.nominal_model == "autorally-nn")
       return run_with_plant(config,
-                            AutoRallyNetworkWithEffects(AutoRallyNetwork::load(file.network_npz.empty()
-                                                                                   ? data_file(kDefaultNetwork)
-                                                                                   : file.network_npz),
+                            AutoRallyNetworkWithEffects(AutoRallyNetwork::load(network_file_or_default(file.network_npz)),
                                                         file.effects),
                             track, cost);
     return run_with_plant(config, CorrectedSingleTrack(file.nominal, file.effects), track, cost);

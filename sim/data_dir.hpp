@@ -15,4 +15,9 @@ std::string data_file(const std::string& relative);
 // The shipped AutoRally network (data/autorally/models), relative to the data folder.
 inline constexpr const char* kDefaultNetworkFile = "autorally/models/autorally_nnet_09_12_2018.npz";
 
+// `npz_path`, or the shipped network where it is empty.
+inline std::string network_file_or_default(const std::string& npz_path) {
+  return npz_path.empty() ? data_file(kDefaultNetworkFile) : npz_path;
+}
+
 }  // namespace mppi::sim

@@ -100,15 +100,14 @@ std::unique_ptr<ModelFamily> model_family_of(const CorrectedModelFile& file) {
     return std::make_unique<WrappedFamily<KinematicBicycle>>(KinematicBicycle(f.kinematic), f);
   if (f.nominal_model == "autorally-nn")
     return std::make_unique<WrappedFamily<AutoRallyNetwork>>(
-        AutoRallyNetwork::load(f.network_npz.empty() ? sim::data_file(sim::kDefaultNetworkFile) : f.network_npz), f);
+        AutoRallyNetwork::load(sim::network_file_or_default(f.network_npz)), f);
   if (f.nominal_model != "single-track")
     throw Error("nominal model '" + f.nominal_model + "' cannot be diagnosed (valid: " + kCorrectedNominalModels + ")");
   return std::make_unique<SingleTrackFamily>(f.nominal);
 }
 
 std::unique_ptr<ModelFamily> make_model_family(const std::string& model, const std::string& params_path) {
-  if (model != "single-track" && model != "double-track" && model != "full-vehicle" && model != "kinematic" &&
-      model != "autorally-nn")
+  if (!is_corrected_nominal_model(model))
     throw Error("nominal model '" + model + "' cannot be diagnosed (valid: " + kCorrectedNominalModels + ")");
   CorrectedModelFile f;
   f.nominal_model = model;

@@ -131,7 +131,7 @@ sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t see
     return drive_open_loop(KinematicWithEffects(KinematicBicycle(), truth), seed, duration_s, noise);
   if (nominal_model == "autorally-nn")
     return drive_open_loop(
-        AutoRallyNetworkWithEffects(AutoRallyNetwork::load(sim::data_file(sim::kDefaultNetworkFile)), truth), seed,
+        AutoRallyNetworkWithEffects(AutoRallyNetwork::load(sim::network_file_or_default("")), truth), seed,
         duration_s, noise);
   if (nominal_model != "single-track")
     throw Error("synthesize_open_loop: unknown nominal model '" + nominal_model + "'");

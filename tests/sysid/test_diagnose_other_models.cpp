@@ -122,6 +122,17 @@ TEST_CASE("corrected-model file with a double-track nominal: round trip and mism
   CHECK(g.nominal.mass_kg == Approx(19.5));
   CHECK(g.effects.steer_lag_s == Approx(0.05));
   CHECK_THROWS_AS(corrected_model_from_yaml("model: corrected\nnominal: diff-drive\n", "bad"), Error);
+  // The kinematic and network nominals round-trip too; a misspelt network key names itself.
+  CorrectedModelFile k;
+  k.nominal_model = "kinematic";
+  k.kinematic.wheelbase_m = 0.61;
+  CHECK(corrected_model_from_yaml(corrected_model_to_yaml(k), "kinematic").kinematic.wheelbase_m == Approx(0.61));
+  CorrectedModelFile n;
+  n.nominal_model = "autorally-nn";
+  n.network_npz = "weights/net.npz";
+  CHECK(corrected_model_from_yaml(corrected_model_to_yaml(n), "network").network_npz == "weights/net.npz");
+  CHECK_THROWS_WITH(corrected_model_from_yaml("model: corrected\nnominal: autorally-nn\nnominal_params: {network: x}\n", "bad"),
+                    Catch::Contains("unknown key 'network'"));
   const std::string path = (std::filesystem::temp_directory_path() / "mppi_dt_corrected.yaml").string();
   std::ofstream(path) << text;
   CHECK(make_model_family("double-track", path)->name() == "double-track");
