@@ -25,6 +25,7 @@
 #include "dynamics/kinematic_bicycle.hpp"
 #include "dynamics/single_track.hpp"
 #include "dynamics/vehicle_params.hpp"
+#include "dynamics/model_registry.hpp"
 #include "mppi/controller.hpp"
 #include "mppi/error.hpp"
 #include "sim/closed_loop.hpp"
@@ -82,8 +83,8 @@ void build(PyController& c, Model model, const AnyCost& cost, const mppi::Contro
   std::visit([&](const auto& concrete) {
     using C = std::decay_t<decltype(concrete)>;
     if constexpr (std::is_same_v<C, mppi::AutoRallyCost> && !mppi::VehicleDynamics<Model>)
-      throw mppi::Error("AutoRallyCost needs a vehicle model (autorally-nn, single-track, kinematic); "
-                        "use GoalObstacleCost with diff-drive");
+      throw mppi::Error("AutoRallyCost needs a vehicle model (" + mppi::model_names() +
+                        "); use GoalObstacleCost with diff-drive");
     else
       c.controller = std::make_unique<mppi::Controller>(mppi::make_cpu_controller(model, concrete, o));
   }, cost);
@@ -91,34 +92,25 @@ void build(PyController& c, Model model, const AnyCost& cost, const mppi::Contro
     c.init_state = [model](const mppi::VehicleState& s, float* x) { model.init_state(s, x); };
 }
 
-// model: autorally-nn | single-track | kinematic | diff-drive; model_file: network npz or
+// model: a registered model (mppi::model_names()) or diff-drive; model_file: network npz or
 // parameter YAML (empty = the library's default).
 std::unique_ptr<PyController> make_controller(const std::string& model, const AnyCost& cost,
                                               const mppi::ControllerOptions& options,
                                               const std::string& model_file) {
   auto c = std::make_unique<PyController>();
   c->model = model;
-  if (model == "autorally-nn") {
-    build(*c,
-          mppi::AutoRallyNetwork::load(model_file.empty()
-                                           ? mppi::sim::data_file("autorally/models/autorally_nnet_09_12_2018.npz")
-                                           : model_file),
-          cost, options);
-  } else if (model == "single-track") {
-    build(*c,
-          mppi::SingleTrack(mppi::load_single_track_params(
-              model_file.empty() ? mppi::sim::data_file("config/autorally_single_track.yaml") : model_file)),
-          cost, options);
-  } else if (model == "kinematic") {
-    build(*c,
-          mppi::KinematicBicycle(model_file.empty() ? mppi::KinematicBicycleParams{}
-                                                    : mppi::load_kinematic_bicycle_params(model_file)),
-          cost, options);
-  } else if (model == "diff-drive") {
+  if (model == "diff-drive") {
     if (!model_file.empty()) throw mppi::Error("diff-drive takes no model_file (use DiffDriveParams)");
     build(*c, mppi::DiffDrive(), cost, options);
+  } else if (mppi::is_registered_model(model)) {
+    mppi::with_model(model, [&]<class D>() {
+      const std::string default_file = D::kDefaultFile;
+      const std::string file =
+          !model_file.empty() || default_file.empty() ? model_file : mppi::sim::data_file(default_file);
+      build(*c, D::load(file), cost, options);
+    });
   } else {
-    throw mppi::Error("unknown model '" + model + "' (valid: autorally-nn, single-track, kinematic, diff-drive)");
+    throw mppi::Error("unknown model '" + model + "' (valid: " + mppi::model_names() + ", diff-drive)");
   }
   return c;
 }

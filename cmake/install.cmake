@@ -6,6 +6,7 @@ foreach(folder IN ITEMS mppi dynamics costs sim chassis)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${folder}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/${folder}
           FILES_MATCHING PATTERN "*.hpp")
 endforeach()
+install(FILES ${MPPI_GENERATED_DIR}/mppi/model_list.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/mppi)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/data/ DESTINATION ${CMAKE_INSTALL_DATADIR}/mppi/data)
 
 install(TARGETS mppi_core mppi_io mppi_sim mppi_chassis mppi_warnings EXPORT mppiTargets

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "dynamics/pacejka.hpp"
+#include "mppi/param_table.hpp"
 
 namespace mppi {
 
@@ -154,33 +155,102 @@ std::string to_yaml(const FullVehicleParams& p);
 
 // ---------------------------------------------------------------------------------------------
 
+// ---- the parameter tables (YAML key, unit, valid range, doc), one per parameter struct -------
+// The loaders, writers, estimators' parameter vectors and --help text come from these; is_valid()
+// checks their ranges, then the conditions that tie several fields together.
+
+inline std::vector<ParamField> param_table(PacejkaParams& t) {
+  return {
+      param("tyre.B", &t.B, "-", positive(), "Magic Formula stiffness factor"),
+      param("tyre.C", &t.C, "-", open(0, 2), "Magic Formula shape factor"),
+      param("tyre.D", &t.D, "-", positive(), "Magic Formula peak factor (peak friction coefficient)"),
+      param("tyre.E", &t.E, "-", open(-kInf, 1), "Magic Formula curvature factor"),
+      param("tyre.Sh", &t.Sh, "-", any_finite(), "Magic Formula horizontal shift (slip)"),
+      param("tyre.Sv", &t.Sv, "-", any_finite(), "Magic Formula vertical shift (friction)"),
+  };
+}
+
+// The single-track keys; the full vehicle has no aero_drag_kgpm (its drag has its own terms).
+inline std::vector<ParamField> param_table(SingleTrackParams& p, bool with_aero_drag = true) {
+  std::vector<ParamField> f = {
+      param("mass_kg", &p.mass_kg, "kg", positive(), "total mass m"),
+      param("yaw_inertia_kgm2", &p.yaw_inertia_kgm2, "kg m^2", positive(), "yaw inertia I_z about the CG"),
+      param("cg_to_front_axle_m", &p.cg_to_front_axle_m, "m", positive(), "CG to front axle l_f"),
+      param("cg_to_rear_axle_m", &p.cg_to_rear_axle_m, "m", positive(), "CG to rear axle l_r"),
+      param("cg_height_m", &p.cg_height_m, "m", non_negative(), "CG height h (load transfer)"),
+      param("wheel_radius_m", &p.wheel_radius_m, "m", positive(), "wheel radius R"),
+      param("front_wheel_inertia_kgm2", &p.front_wheel_inertia_kgm2, "kg m^2", positive(),
+            "both front wheels' spin inertia I_f"),
+      param("rear_wheel_inertia_kgm2", &p.rear_wheel_inertia_kgm2, "kg m^2", positive(),
+            "both rear wheels' spin inertia I_r"),
+      param("gravity_mps2", &p.gravity_mps2, "m/s^2", positive(), "gravity g"),
+      param("max_steer_rad", &p.max_steer_rad, "rad", open(0, 1.5), "front wheel angle at steer = +-1"),
+      param("stall_torque_Nm", &p.stall_torque_Nm, "N m", non_negative(), "rear axle torque at throttle 1, wheel still"),
+      param("no_load_speed_mps", &p.no_load_speed_mps, "m/s", positive(), "rim speed where throttle 1 gives no torque"),
+      param("rolling_resistance", &p.rolling_resistance, "-", non_negative(), "rolling resistance c_rr (force c_rr m g)"),
+      param("rolling_resistance_speed_mps", &p.rolling_resistance_speed_mps, "m/s", positive(),
+            "speed v_rr smoothing the resistance's sign at standstill"),
+      param("aero_drag_kgpm", &p.aero_drag_kgpm, "N s^2/m^2", non_negative(), "drag c_d (force c_d vx |vx|)"),
+      param("slip_speed_floor_mps", &p.slip_speed_floor_mps, "m/s", positive(), "slip denominator floor v_floor"),
+      param("slip_blend", &p.slip_blend, "-", positive(), "slip blend eps: force x tanh(s / eps)"),
+  };
+  if (!with_aero_drag) f.erase(f.begin() + 14);  // aero_drag_kgpm
+  for (const ParamField& t : param_table(p.tyre)) f.push_back(t);
+  return f;
+}
+
+inline std::vector<ParamField> param_table(KinematicBicycleParams& p) {
+  return {
+      param("wheelbase_m", &p.wheelbase_m, "m", positive(), "wheelbase L"),
+      param("max_steer_rad", &p.max_steer_rad, "rad", open(0, 1.5), "front wheel angle at steer = +-1"),
+      param("max_accel_mps2", &p.max_accel_mps2, "m/s^2", non_negative(), "dv/dt at throttle 1 and v = 0"),
+      param("speed_damping_per_s", &p.speed_damping_per_s, "1/s", non_negative(), "linear speed damping"),
+  };
+}
+
+inline std::vector<ParamField> param_table(DoubleTrackParams& p) {
+  std::vector<ParamField> f = param_table(p.base);
+  f.insert(f.end() - 6,  // before the tyre map
+           {param("front_track_m", &p.front_track_m, "m", positive(), "front track width w_f"),
+            param("rear_track_m", &p.rear_track_m, "m", positive(), "rear track width w_r"),
+            param("front_roll_share", &p.front_roll_share, "-", closed(0, 1),
+                  "share of the roll moment carried by the front axle"),
+            param("lateral_load_transfer", &p.lateral_load_transfer, "-", closed(0, 1),
+                  "scale of the lateral load transfer (0 = single-track limit)")});
+  return f;
+}
+
+inline std::vector<ParamField> param_table(FullVehicleParams& p) {
+  std::vector<ParamField> f = param_table(p.base, /*with_aero_drag=*/false);
+  f.insert(f.end() - 6,
+           {param("front_track_m", &p.front_track_m, "m", positive(), "front track width w_f"),
+            param("rear_track_m", &p.rear_track_m, "m", positive(), "rear track width w_r"),
+            param("front_wheel_mass_kg", &p.front_wheel_mass_kg, "kg", non_negative(), "unsprung mass per front wheel"),
+            param("rear_wheel_mass_kg", &p.rear_wheel_mass_kg, "kg", non_negative(), "unsprung mass per rear wheel"),
+            param("front_spring_Npm", &p.front_spring_Npm, "N/m", positive(), "spring rate K_f per front wheel"),
+            param("rear_spring_Npm", &p.rear_spring_Npm, "N/m", positive(), "spring rate K_r per rear wheel"),
+            param("front_damper_Nspm", &p.front_damper_Nspm, "N s/m", non_negative(), "damper C_f per front wheel"),
+            param("rear_damper_Nspm", &p.rear_damper_Nspm, "N s/m", non_negative(), "damper C_r per rear wheel"),
+            param("sprung_cg_height_m", &p.sprung_cg_height_m, "m", non_negative(), "sprung CG height h^s"),
+            param("roll_centre_height_m", &p.roll_centre_height_m, "m", any_finite(), "roll-centre height h^c"),
+            param("roll_inertia_kgm2", &p.roll_inertia_kgm2, "kg m^2", positive(), "sprung roll inertia I^R_x"),
+            param("pitch_inertia_kgm2", &p.pitch_inertia_kgm2, "kg m^2", positive(), "sprung pitch inertia I^P_y"),
+            param("drag_coefficient", &p.drag_coefficient, "-", non_negative(), "drag coefficient C_D"),
+            param("air_density_kgpm3", &p.air_density_kgpm3, "kg/m^3", non_negative(), "air density rho"),
+            param("frontal_area_m2", &p.frontal_area_m2, "m^2", non_negative(), "frontal area A")});
+  return f;
+}
+
 inline bool SingleTrackParams::is_valid(std::string* why) const {
   auto fail = [&](const std::string& msg) {
     if (why) *why = msg;
     return false;
   };
-  auto positive = [](double v) { return std::isfinite(v) && v > 0; };
-  if (!positive(mass_kg)) return fail("mass_kg must be > 0");
-  if (!positive(yaw_inertia_kgm2)) return fail("yaw_inertia_kgm2 must be > 0");
-  if (!positive(cg_to_front_axle_m)) return fail("cg_to_front_axle_m must be > 0");
-  if (!positive(cg_to_rear_axle_m)) return fail("cg_to_rear_axle_m must be > 0");
-  if (!(std::isfinite(cg_height_m) && cg_height_m >= 0)) return fail("cg_height_m must be >= 0");
-  if (!positive(wheel_radius_m)) return fail("wheel_radius_m must be > 0");
-  if (!positive(front_wheel_inertia_kgm2)) return fail("front_wheel_inertia_kgm2 must be > 0");
-  if (!positive(rear_wheel_inertia_kgm2)) return fail("rear_wheel_inertia_kgm2 must be > 0");
-  if (!positive(gravity_mps2)) return fail("gravity_mps2 must be > 0");
+  SingleTrackParams copy = *this;
+  std::vector<ParamField> fields = param_table(copy);
+  fields.resize(fields.size() - 6);  // the tyre: checked whole by PacejkaParams::is_valid
+  if (const std::string e = first_range_error(fields); !e.empty()) return fail(e);
   if (!tyre.is_valid(why)) return false;
-  if (!(positive(max_steer_rad) && max_steer_rad < 1.5))
-    return fail("max_steer_rad must be in (0, 1.5)");
-  if (!(std::isfinite(stall_torque_Nm) && stall_torque_Nm >= 0))
-    return fail("stall_torque_Nm must be >= 0");
-  if (!positive(no_load_speed_mps)) return fail("no_load_speed_mps must be > 0");
-  if (!(std::isfinite(rolling_resistance) && rolling_resistance >= 0))
-    return fail("rolling_resistance must be >= 0");
-  if (!positive(rolling_resistance_speed_mps)) return fail("rolling_resistance_speed_mps must be > 0");
-  if (!(std::isfinite(aero_drag_kgpm) && aero_drag_kgpm >= 0)) return fail("aero_drag_kgpm must be >= 0");
-  if (!positive(slip_speed_floor_mps)) return fail("slip_speed_floor_mps must be > 0");
-  if (!positive(slip_blend)) return fail("slip_blend must be > 0");
   // The load-transfer denominator l_f + l_r + h (mu_Fx cos d - mu_Fy sin d - mu_Rx) stays
   // positive for any slips when h * 2 * max|mu| < wheelbase.
   const double mu_bound = std::abs(tyre.D) + std::abs(tyre.Sv);
@@ -190,16 +260,12 @@ inline bool SingleTrackParams::is_valid(std::string* why) const {
 }
 
 inline bool DoubleTrackParams::is_valid(std::string* why) const {
-  auto fail = [&](const std::string& msg) {
-    if (why) *why = msg;
-    return false;
-  };
   if (!base.is_valid(why)) return false;
-  if (!(std::isfinite(front_track_m) && front_track_m > 0)) return fail("front_track_m must be > 0");
-  if (!(std::isfinite(rear_track_m) && rear_track_m > 0)) return fail("rear_track_m must be > 0");
-  if (!(front_roll_share >= 0 && front_roll_share <= 1)) return fail("front_roll_share must be in [0, 1]");
-  if (!(lateral_load_transfer >= 0 && lateral_load_transfer <= 1))
-    return fail("lateral_load_transfer must be in [0, 1]");
+  DoubleTrackParams copy = *this;
+  if (const std::string e = first_range_error(param_table(copy)); !e.empty()) {
+    if (why) *why = e;
+    return false;
+  }
   return true;
 }
 
@@ -219,29 +285,15 @@ inline bool FullVehicleParams::is_valid(std::string* why) const {
     if (why) *why = msg;
     return false;
   };
-  auto positive = [](double v) { return std::isfinite(v) && v > 0; };
-  auto non_negative = [](double v) { return std::isfinite(v) && v >= 0; };
   if (!base.is_valid(why)) return false;
   if (base.aero_drag_kgpm != 0)
     return fail("aero_drag_kgpm must be 0 for the full vehicle (drag is drag_coefficient, "
                 "air_density_kgpm3, frontal_area_m2)");
-  if (!positive(front_track_m)) return fail("front_track_m must be > 0");
-  if (!positive(rear_track_m)) return fail("rear_track_m must be > 0");
-  if (!non_negative(front_wheel_mass_kg)) return fail("front_wheel_mass_kg must be >= 0");
-  if (!non_negative(rear_wheel_mass_kg)) return fail("rear_wheel_mass_kg must be >= 0");
+  FullVehicleParams copy = *this;
+  if (const std::string e = first_range_error(param_table(copy)); !e.empty()) return fail(e);
   if (!(sprung_mass_kg() > 0)) return fail("the wheel masses must leave a sprung mass > 0");
-  if (!positive(front_spring_Npm)) return fail("front_spring_Npm must be > 0");
-  if (!positive(rear_spring_Npm)) return fail("rear_spring_Npm must be > 0");
-  if (!non_negative(front_damper_Nspm)) return fail("front_damper_Nspm must be >= 0");
-  if (!non_negative(rear_damper_Nspm)) return fail("rear_damper_Nspm must be >= 0");
-  if (!non_negative(sprung_cg_height_m)) return fail("sprung_cg_height_m must be >= 0");
-  if (!(std::isfinite(roll_centre_height_m) && roll_centre_height_m <= sprung_cg_height_m))
+  if (!(roll_centre_height_m <= sprung_cg_height_m))
     return fail("roll_centre_height_m must be <= sprung_cg_height_m");
-  if (!positive(roll_inertia_kgm2)) return fail("roll_inertia_kgm2 must be > 0");
-  if (!positive(pitch_inertia_kgm2)) return fail("pitch_inertia_kgm2 must be > 0");
-  if (!non_negative(drag_coefficient)) return fail("drag_coefficient must be >= 0");
-  if (!non_negative(air_density_kgpm3)) return fail("air_density_kgpm3 must be >= 0");
-  if (!non_negative(frontal_area_m2)) return fail("frontal_area_m2 must be >= 0");
   // Gravity must not beat the springs (the sprung mass would tip over at rest).
   const double ms = sprung_mass_kg(), g = base.gravity_mps2;
   const double roll_k = 0.5 * (front_spring_Npm * front_track_m * front_track_m +
@@ -256,16 +308,11 @@ inline bool FullVehicleParams::is_valid(std::string* why) const {
 }
 
 inline bool KinematicBicycleParams::is_valid(std::string* why) const {
-  auto fail = [&](const std::string& msg) {
-    if (why) *why = msg;
+  KinematicBicycleParams copy = *this;
+  if (const std::string e = first_range_error(param_table(copy)); !e.empty()) {
+    if (why) *why = e;
     return false;
-  };
-  if (!(std::isfinite(wheelbase_m) && wheelbase_m > 0)) return fail("wheelbase_m must be > 0");
-  if (!(std::isfinite(max_steer_rad) && max_steer_rad > 0 && max_steer_rad < 1.5))
-    return fail("max_steer_rad must be in (0, 1.5)");
-  if (!(std::isfinite(max_accel_mps2) && max_accel_mps2 >= 0)) return fail("max_accel_mps2 must be >= 0");
-  if (!(std::isfinite(speed_damping_per_s) && speed_damping_per_s >= 0))
-    return fail("speed_damping_per_s must be >= 0");
+  }
   return true;
 }
 

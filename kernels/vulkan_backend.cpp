@@ -4,6 +4,7 @@
 #include <stdint.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -14,10 +15,9 @@
 #include "mppi/error.hpp"
 
 // SPIR-V made at build time by glslangValidator (kernels/CMakeLists.txt), checked by spirv-val.
-#include "rollout_kinematic.spv.h"
-#include "rollout_network.spv.h"
-#include "rollout_single_track.spv.h"
+#include "costs/autorally_cost_gpu.hpp"
 #include "reduce.spv.h"
+#include "rollout_kernels.hpp"
 #include "weighted_sum.spv.h"
 
 namespace mppi::vulkan {
@@ -25,7 +25,7 @@ namespace mppi::vulkan {
 namespace {
 constexpr int kRolloutGroup = 64;      // invocations per workgroup of the rollout shader
 constexpr int kParamFloats = 4096;     // the parameter uniform buffer: vec4 params[1024]
-constexpr int kCostFloats = 16;        // its first 16 floats are the cost (interface.glsl)
+constexpr int kCostFloats = kGpuCostFloats;  // its first floats are the cost (layout_cost.glsl)
 constexpr int kNu = 2;                 // every GPU twin has (steer, throttle)
 constexpr int kMaxStates = 16;
 
@@ -39,92 +39,29 @@ struct StepUbo {
   float control_max[4];
   float x0[kMaxStates];
 };
+// The std140 offsets of StepBlock: uvec4/vec4 members at 16-byte steps, x0 as vec4[4].
+static_assert(offsetof(StepUbo, seed) == 16 && offsetof(StepUbo, scalars) == 32 &&
+              offsetof(StepUbo, noise_std) == 48 && offsetof(StepUbo, control_min) == 64 &&
+              offsetof(StepUbo, control_max) == 80 && offsetof(StepUbo, x0) == 96 &&
+              sizeof(StepUbo) == 96 + 4 * kMaxStates, "StepUbo must mirror StepBlock (std140)");
 
 void check(VkResult r, const char* what) {
   if (r != VK_SUCCESS)
     throw Error(std::string("Vulkan backend: ") + what + " failed: " + detail::result_name(r));
 }
 
-// The cost's floats at the start of the parameter block (the P_* offsets of interface.glsl).
+// The cost's floats at the start of the parameter block, in the order of the table the GLSL
+// offsets are generated from (costs/autorally_cost_gpu.hpp).
 void pack_cost(const AutoRallyCost& cost, float* p) {
-  const AutoRallyCostParams& c = cost.params();
-  const CostMap::View v = cost.map().view();
-  p[0] = c.track_weight;
-  p[1] = c.speed_weight;
-  p[2] = c.crash_weight;
-  p[3] = c.slip_weight;
-  p[4] = c.target_speed_mps;
-  p[5] = c.boundary_threshold;
-  p[6] = c.max_roll_rad;
-  p[7] = c.max_yaw_rate_radps;
-  p[8] = c.slip_min_speed_mps;
-  p[9] = v.x_min_m;
-  p[10] = v.y_min_m;
-  p[11] = v.pixels_per_meter;
-  p[12] = v.max_col;
-  p[13] = v.max_row;
-  p[14] = static_cast<float>(v.width);
+  for (const GpuCostField& field : gpu_cost_fields()) *p++ = field.value(cost);
+}
+
+const RolloutKernel* find_kernel(const std::string& id) {
+  for (const RolloutKernel& k : kRolloutKernels)
+    if (id == k.id) return &k;
+  return nullptr;
 }
 }  // namespace
-
-// ---- the GPU twins ----------------------------------------------------------------------------
-
-std::optional<TwinModel> twin_of(const KinematicBicycle& m, std::string*) {
-  const KinematicBicycleParams& p = m.params();
-  TwinModel t;
-  t.kind = TwinModel::Kind::kKinematic;
-  t.num_states = KinematicBicycle::kNx;
-  // as KinematicBicycle's constructor computes them
-  t.params = {static_cast<float>(1 / p.wheelbase_m), static_cast<float>(p.max_steer_rad),
-              static_cast<float>(p.max_accel_mps2), static_cast<float>(p.speed_damping_per_s)};
-  return t;
-}
-
-std::optional<TwinModel> twin_of(const AutoRallyNetwork& m, std::string* why) {
-  const std::vector<DenseLayer>& layers = m.network().layers();
-  auto fail = [&](const std::string& msg) -> std::optional<TwinModel> {
-    if (why) *why = "no GPU twin for this network: " + msg;
-    return std::nullopt;
-  };
-  if (layers.size() != 3) return fail("the shader runs 3 layers, the network has " + std::to_string(layers.size()));
-  if (layers[0].activation != Activation::kTanh || layers[1].activation != Activation::kTanh ||
-      layers[2].activation != Activation::kLinear)
-    return fail("the shader runs tanh, tanh, linear layers");
-  const int h1 = layers[0].n_out, h2 = layers[1].n_out;
-  if (h1 > 128 || h2 > 128) return fail("hidden layers wider than 128");
-  TwinModel t;
-  t.kind = TwinModel::Kind::kNetwork;
-  t.num_states = AutoRallyNetwork::kNx;
-  t.hidden1 = h1;
-  t.hidden2 = h2;
-  // Each layer: W with every row padded to a multiple of 4 floats, then b padded to a multiple
-  // of 4 (the layout shaders/model_network.glsl reads 4 weights at a time).
-  auto pad4 = [](int n) { return (n + 3) / 4 * 4; };
-  for (const DenseLayer& l : layers) {
-    for (int o = 0; o < l.n_out; ++o) {
-      const auto row = l.weights.begin() + static_cast<std::ptrdiff_t>(o) * l.n_in;
-      t.params.insert(t.params.end(), row, row + l.n_in);
-      t.params.resize(t.params.size() + static_cast<std::size_t>(pad4(l.n_in) - l.n_in), 0.f);
-    }
-    t.params.insert(t.params.end(), l.bias.begin(), l.bias.end());
-    t.params.resize(t.params.size() + static_cast<std::size_t>(pad4(l.n_out) - l.n_out), 0.f);
-  }
-  if (static_cast<int>(t.params.size()) + kCostFloats > kParamFloats)
-    return fail("its " + std::to_string(t.params.size()) + " weights do not fit the 16 KiB uniform buffer");
-  return t;
-}
-
-std::optional<TwinModel> twin_of(const SingleTrack& m, std::string*) {
-  const auto k = SingleTrackCoeffs<float>::from(m.params());
-  TwinModel t;
-  t.kind = TwinModel::Kind::kSingleTrack;
-  t.num_states = SingleTrack::kNx;
-  t.params = {k.inv_mass, k.inv_yaw_inertia, k.lf, k.lr, k.h, k.radius, k.inv_front_inertia,
-              k.inv_rear_inertia, k.weight, k.max_steer, k.stall_torque, k.inv_no_load_speed,
-              k.rolling_force, k.inv_rolling_speed, k.drag, k.slip_floor, k.inv_slip_blend,
-              k.tyre.B, k.tyre.C, k.tyre.D, k.tyre.E, k.tyre.Sh, k.tyre.Sv};
-  return t;
-}
 
 // ---- the backend ------------------------------------------------------------------------------
 
@@ -318,23 +255,20 @@ struct VulkanBackend::Impl {
     pl_info.pSetLayouts = &set_layout;
     check(api.vkCreatePipelineLayout(device, &pl_info, nullptr, &pipeline_layout), "vkCreatePipelineLayout");
 
-    const std::uint32_t* code = nullptr;
-    std::size_t bytes = 0;
-    switch (model.kind) {
-      case TwinModel::Kind::kKinematic: code = rollout_kinematic_spv; bytes = sizeof rollout_kinematic_spv; break;
-      case TwinModel::Kind::kNetwork: code = rollout_network_spv; bytes = sizeof rollout_network_spv; break;
-      case TwinModel::Kind::kSingleTrack: code = rollout_single_track_spv; bytes = sizeof rollout_single_track_spv; break;
-    }
+    const RolloutKernel* kernel = find_kernel(model.kernel);
+    if (!kernel) throw Error("Vulkan backend: no rollout shader for the model kernel '" + model.kernel + "'");
+    const std::uint32_t* code = kernel->code;
+    const std::size_t bytes = kernel->bytes;
     struct Spec {
       std::uint32_t group;
       VkBool32 generate;
-      std::int32_t hidden1, hidden2;
+      std::int32_t constant_a, constant_b;
     };
     const VkSpecializationMapEntry entries[] = {{0, offsetof(Spec, group), 4},
                                                 {1, offsetof(Spec, generate), 4},
-                                                {2, offsetof(Spec, hidden1), 4},
-                                                {3, offsetof(Spec, hidden2), 4}};
-    Spec values{kRolloutGroup, VK_TRUE, std::max(model.hidden1, 1), std::max(model.hidden2, 1)};
+                                                {2, offsetof(Spec, constant_a), 4},
+                                                {3, offsetof(Spec, constant_b), 4}};
+    Spec values{kRolloutGroup, VK_TRUE, std::max(model.constant_a, 1), std::max(model.constant_b, 1)};
     VkSpecializationInfo spec{4, entries, sizeof(Spec), &values};
     rollout_generate = make_pipeline(code, bytes, &spec);
     values.generate = VK_FALSE;
@@ -460,6 +394,9 @@ VulkanBackend::VulkanBackend(const TwinModel& model, const AutoRallyCost& cost, 
 
   // Constant data: cost + model parameters, the cost map, the crash cost per step (computed
   // here with the CPU's own std::pow so both sides use the same numbers).
+  if (static_cast<int>(model.params.size()) + kCostFloats > kParamFloats)
+    throw Error("Vulkan backend: the model's " + std::to_string(model.params.size()) +
+                " parameter floats do not fit the 16 KiB uniform buffer");
   float* params = m.buffers[Impl::kParams].f();
   pack_cost(cost, params);
   std::copy(model.params.begin(), model.params.end(), params + kCostFloats);

@@ -1,7 +1,7 @@
 #pragma once
 // The Vulkan compute backend: the same MPPI as the CPU backend on any Vulkan 1.1 device.
-// GLSL shaders in kernels/shaders/ (compiled to SPIR-V at build time) roll out the kinematic
-// bicycle, the AutoRally network or the single-track Pacejka model under the AutoRally cost,
+// GLSL shaders in kernels/shaders/ (compiled to SPIR-V at build time) roll out any model whose
+// descriptor declares a GPU twin (kernels/shaders/models/<kernel>.glsl) under the AutoRally cost,
 // draw the Philox noise on the device and form the weighted update there. Buffers are
 // allocated once per (K, T), descriptor sets written once, two command buffers recorded once
 // and replayed; per step only a small uniform buffer and the T x nu plan are written.
@@ -17,6 +17,7 @@
 #include "dynamics/kinematic_bicycle.hpp"
 #include "dynamics/single_track.hpp"
 #include "mppi/backend.hpp"
+#include "mppi/gpu_twin.hpp"
 
 namespace mppi::vulkan {
 
@@ -43,17 +44,14 @@ Probe probe();
 // Returns the index into probe.devices, or -1 with the reason in *why.
 int pick_device(const Probe& probe, bool allow_cpu, std::string* why);
 
-// A model as the shaders see it: which shader and its parameters (floats after the cost's).
-struct TwinModel {
-  enum class Kind { kKinematic, kNetwork, kSingleTrack } kind = Kind::kKinematic;
-  int num_states = 0;
-  int hidden1 = 0, hidden2 = 0;  // network only
-  std::vector<float> params;
-};
+// A model as the shaders see it: its kernel, state size and parameter floats, made from the
+// model's descriptor (mppi/gpu_twin.hpp).
+using TwinModel = GpuModel;
 // The GPU twin of a model, or nullopt and why (e.g. a network of another shape).
-std::optional<TwinModel> twin_of(const KinematicBicycle& m, std::string* why);
-std::optional<TwinModel> twin_of(const AutoRallyNetwork& m, std::string* why);
-std::optional<TwinModel> twin_of(const SingleTrack& m, std::string* why);
+template <class M>
+std::optional<TwinModel> twin_of(const M& model, std::string* why) {
+  return gpu_twin_of(model, why);
+}
 
 class Context;  // instance, device, queue (vulkan_context.cpp)
 

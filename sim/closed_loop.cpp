@@ -12,19 +12,13 @@
 #include "costs/autorally_cost.hpp"
 #include "costs/cost_config.hpp"
 #include "costs/cost_map.hpp"
-#include "dynamics/autorally_nn.hpp"
-#include "dynamics/double_track.hpp"
-#include "dynamics/full_vehicle.hpp"
 #include "dynamics/corrected_single_track.hpp"
+#include "dynamics/model_registry.hpp"
 #include "dynamics/with_effects.hpp"
-#include "dynamics/kinematic_bicycle.hpp"
-#include "dynamics/single_track.hpp"
-#include "dynamics/vehicle_params.hpp"
+#include "dynamics/four_wheel_observe.hpp"
 #include "mppi/controller.hpp"
-#if defined(MPPI_HAVE_VULKAN)
-#include "kernels/make_controller.hpp"
-#endif
 #include "mppi/error.hpp"
+#include "mppi/make_controller.hpp"
 #include "sim/crash_detector.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/geometry.hpp"
@@ -36,34 +30,72 @@ namespace mppi::sim {
 namespace {
 
 constexpr const char* kDefaultCostYaml = "config/autorally_cost.yaml";
-constexpr const char* kDefaultSingleTrackYaml = "config/autorally_single_track.yaml";
-constexpr const char* kDefaultDoubleTrackYaml = "config/autorally_double_track.yaml";
-constexpr const char* kDefaultFullVehicleYaml = "config/autorally_full_vehicle.yaml";
+// Not a registered model: a model written by mppi-fit diagnose (a nominal + effects file).
+constexpr const char* kCorrectedModel = "corrected";
 
-DoubleTrackParams double_track_params(const std::string& yaml) {
-  return load_double_track_params(yaml.empty() ? data_file(kDefaultDoubleTrackYaml) : yaml);
-}
-FullVehicleParams full_vehicle_params(const std::string& yaml) {
-  return load_full_vehicle_params(yaml.empty() ? data_file(kDefaultFullVehicleYaml) : yaml);
+// The data file of a registered model: the given file; for a model whose data are weights
+// (npz), the --network file; else the model's default data file; "" = built-in defaults.
+template <class D>
+std::string model_file(const std::string& params_file, const std::string& weights_file) {
+  if (!params_file.empty()) return params_file;
+  const std::string default_file = D::kDefaultFile;
+  const bool weights = default_file.size() > 4 && default_file.substr(default_file.size() - 4) == ".npz";
+  if (weights && !weights_file.empty()) return weights_file;
+  return default_file.empty() ? std::string() : data_file(default_file);
 }
 
-// Controller-model state from another plant: the common states, wheels rolling at vx / R,
-// the rest (suspension) at rest. The same model's plant state is copied whole.
-template <class M>
-std::function<void(const float*, int, float*)> observe_four_wheel(float radius) {
-  return [radius](const float* px, int plant_states, float* mx) {
-    if (plant_states == M::kNx) {
-      std::copy(px, px + M::kNx, mx);
-      return;
-    }
-    std::fill(mx, mx + M::kNx, 0.f);
-    std::copy(px, px + state::kCommonStates, mx);
-    for (int i = 0; i < 4; ++i) mx[M::kOmega + i] = px[state::kVx] / radius;
+// The model of a corrected-model file (nominal + effects), handed to f as its concrete type,
+// with how it reads a plant's state.
+template <class F>
+auto visit_corrected(const std::string& path, const char* flag, F&& f) {
+  if (path.empty()) throw Error(std::string("--") + flag + " corrected needs --" + flag + "-params FILE");
+  const CorrectedModelFile file = load_corrected_model(path);
+  const std::string& nominal = file.nominal_model;
+  // Other models + effects: read like their base (common states), chains at rest.
+  const auto observe_common = [](int model_states) {
+    return [model_states](const float* px, int plant_states, float* mx) {
+      if (plant_states == model_states) {
+        std::copy(px, px + model_states, mx);
+        return;
+      }
+      std::fill(mx, mx + model_states, 0.f);
+      std::copy(px, px + state::kCommonStates, mx);
+    };
   };
-}
-
-SingleTrackParams single_track_params(const std::string& yaml) {
-  return load_single_track_params(yaml.empty() ? data_file(kDefaultSingleTrackYaml) : yaml);
+  const float radius = static_cast<float>(file.nominal.wheel_radius_m);
+  const auto observe_four_wheel = [radius]<class M>(std::type_identity<M>) {
+    return [radius](const float* px, int plant_states, float* mx) {
+      four_wheel_from_plant<M>(px, plant_states, radius, mx);
+    };
+  };
+  if (nominal == models::Kinematic::kName) {
+    const KinematicWithEffects model(KinematicBicycle(file.kinematic), file.effects);
+    return f(model, observe_common(KinematicWithEffects::kNx));
+  }
+  if (nominal == models::AutoRallyNetworkModel::kName) {
+    const AutoRallyNetworkWithEffects model(AutoRallyNetwork::load(network_file_or_default(file.network_npz)),
+                                            file.effects);
+    return f(model, observe_common(AutoRallyNetworkWithEffects::kNx));
+  }
+  if (nominal == models::DoubleTrackModel::kName) {
+    const DoubleTrackWithEffects model(DoubleTrack(file.double_track), file.effects);
+    return f(model, observe_four_wheel(std::type_identity<DoubleTrackWithEffects>{}));
+  }
+  if (nominal == models::FullVehicleModel::kName) {
+    const FullVehicleWithEffects model(FullVehicle(file.full_vehicle), file.effects);
+    return f(model, observe_four_wheel(std::type_identity<FullVehicleWithEffects>{}));
+  }
+  const CorrectedSingleTrack model(file.nominal, file.effects);
+  return f(model, [radius](const float* px, int plant_states, float* mx) {
+    if (plant_states == CorrectedSingleTrack::kNx) {
+      std::copy(px, px + CorrectedSingleTrack::kNx, mx);
+    } else {
+      std::fill(mx, mx + CorrectedSingleTrack::kNx, 0.f);
+      std::copy(px, px + std::min(plant_states, int{SingleTrack::kNx}), mx);
+      if (plant_states != SingleTrack::kNx)
+        mx[SingleTrack::kOmegaFront] = mx[SingleTrack::kOmegaRear] = px[state::kVx] / radius;
+    }
+  });
 }
 
 // The controller and how it reads the plant: full plant state -> controller model state.
@@ -73,21 +105,13 @@ struct ControllerSetup {
   std::function<void(const float* plant_x, int plant_states, float* model_x)> observe;
 };
 
-// The controller on the backend the config asks for (Vulkan needs the kernels/ part).
+// The controller on the backend the config asks for (mppi/make_controller.hpp).
 template <class D>
 std::unique_ptr<Controller> build_controller(const ClosedLoopConfig& config, const D& model,
                                              const AutoRallyCost& cost) {
   BackendReport report;
-#if defined(MPPI_HAVE_VULKAN)
   auto controller = std::make_unique<Controller>(
       mppi::make_controller(model, cost, config.controller, config.backend, &report));
-#else
-  auto controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
-  report.backend = "cpu";
-  report.reason = config.backend == BackendChoice::kCpu
-                      ? "asked for the CPU backend"
-                      : "built without the Vulkan backend (kernels/); using the CPU backend";
-#endif
   if (config.progress)
     std::fprintf(stderr, "backend: %s%s%s (%s)\n", report.backend.c_str(),
                  report.device.empty() ? "" : " on ", report.device.c_str(), report.reason.c_str());
@@ -95,121 +119,27 @@ std::unique_ptr<Controller> build_controller(const ClosedLoopConfig& config, con
   return controller;
 }
 
-ControllerSetup make_controller(const ClosedLoopConfig& config, const AutoRallyCost& cost) {
+template <class M, class Observe>
+ControllerSetup controller_setup(const ClosedLoopConfig& config, const M& model, const AutoRallyCost& cost,
+                                 Observe observe) {
   ControllerSetup setup;
-  auto copy_common = [](const float* px, int, float* mx) {
-    std::copy(px, px + state::kCommonStates, mx);
-  };
-  if (config.model == "autorally-nn") {
-    auto model = AutoRallyNetwork::load(network_file_or_default(config.network_npz));
-    setup.controller = build_controller(config, model, cost);
-    setup.model_states = AutoRallyNetwork::kNx;
-    setup.observe = copy_common;
-  } else if (config.model == "single-track") {
-    const SingleTrack model(single_track_params(config.model_params_yaml));
-    setup.controller = build_controller(config, model, cost);
-    setup.model_states = SingleTrack::kNx;
-    const float radius = static_cast<float>(model.params().wheel_radius_m);
-    setup.observe = [radius](const float* px, int plant_states, float* mx) {
-      if (plant_states == SingleTrack::kNx) {
-        std::copy(px, px + SingleTrack::kNx, mx);  // same model: wheel speeds are known
-      } else {
-        std::copy(px, px + state::kCommonStates, mx);
-        mx[SingleTrack::kOmegaFront] = mx[SingleTrack::kOmegaRear] = px[state::kVx] / radius;
-      }
-    };
-  } else if (config.model == "kinematic") {
-    const KinematicBicycleParams params = config.model_params_yaml.empty()
-                                              ? KinematicBicycleParams{}
-                                              : load_kinematic_bicycle_params(config.model_params_yaml);
-    const KinematicBicycle model(params);
-    setup.controller = build_controller(config, model, cost);
-    setup.model_states = KinematicBicycle::kNx;
-    // The kinematic bicycle's reference point is the rear axle, l_r behind the CG.
-    const float l_r = static_cast<float>(SingleTrackParams{}.cg_to_rear_axle_m);
-    setup.observe = [l_r](const float* px, int, float* mx) {
-      std::copy(px, px + state::kCommonStates, mx);
-      mx[state::kX] -= l_r * std::cos(px[state::kYaw]);
-      mx[state::kY] -= l_r * std::sin(px[state::kYaw]);
-      mx[state::kVy] = 0.f;
-    };
-  } else if (config.model == "double-track" || config.model == "full-vehicle") {
-    const bool full = config.model == "full-vehicle";
-    if (full) {
-      const FullVehicle model(full_vehicle_params(config.model_params_yaml));
-      setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
-      setup.model_states = FullVehicle::kNx;
-      setup.observe = observe_four_wheel<FullVehicle>(static_cast<float>(model.params().base.wheel_radius_m));
-    } else {
-      const DoubleTrack model(double_track_params(config.model_params_yaml));
-      setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
-      setup.model_states = DoubleTrack::kNx;
-      setup.observe = observe_four_wheel<DoubleTrack>(static_cast<float>(model.params().base.wheel_radius_m));
-    }
-  } else if (config.model == "corrected") {
-    // Nominal + fitted effects (mppi-fit diagnose); a corrected plant shares its state layout.
-    if (config.model_params_yaml.empty()) throw Error("--model corrected needs --model-params FILE");
-    const CorrectedModelFile file = load_corrected_model(config.model_params_yaml);
-    if (file.nominal_model == "kinematic" || file.nominal_model == "autorally-nn") {
-      // The other models + effects: read like their base (common states), chains at rest.
-      const auto observe_common = [](int model_states) {
-        return [model_states](const float* px, int plant_states, float* mx) {
-          if (plant_states == model_states) {
-            std::copy(px, px + model_states, mx);
-            return;
-          }
-          std::fill(mx, mx + model_states, 0.f);
-          std::copy(px, px + state::kCommonStates, mx);
-        };
-      };
-      if (file.nominal_model == "kinematic") {
-        const KinematicWithEffects model(KinematicBicycle(file.kinematic), file.effects);
-        setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
-        setup.model_states = KinematicWithEffects::kNx;
-      } else {
-        const AutoRallyNetworkWithEffects model(
-            AutoRallyNetwork::load(network_file_or_default(file.network_npz)), file.effects);
-        setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
-        setup.model_states = AutoRallyNetworkWithEffects::kNx;
-      }
-      setup.observe = observe_common(setup.model_states);
-      return setup;
-    }
-    if (file.nominal_model == "double-track" || file.nominal_model == "full-vehicle") {
-      // Four-wheel nominal + effects (dynamics/with_effects.hpp).
-      const float radius = static_cast<float>(file.nominal.wheel_radius_m);
-      if (file.nominal_model == "double-track") {
-        const DoubleTrackWithEffects model(DoubleTrack(file.double_track), file.effects);
-        setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
-        setup.model_states = DoubleTrackWithEffects::kNx;
-        setup.observe = observe_four_wheel<DoubleTrackWithEffects>(radius);
-      } else {
-        const FullVehicleWithEffects model(FullVehicle(file.full_vehicle), file.effects);
-        setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
-        setup.model_states = FullVehicleWithEffects::kNx;
-        setup.observe = observe_four_wheel<FullVehicleWithEffects>(radius);
-      }
-      return setup;
-    }
-    const CorrectedSingleTrack model(file.nominal, file.effects);
-    setup.controller = std::make_unique<Controller>(make_cpu_controller(model, cost, config.controller));
-    setup.model_states = CorrectedSingleTrack::kNx;
-    const float radius = static_cast<float>(file.nominal.wheel_radius_m);
-    setup.observe = [radius](const float* px, int plant_states, float* mx) {
-      if (plant_states == CorrectedSingleTrack::kNx) {
-        std::copy(px, px + CorrectedSingleTrack::kNx, mx);
-      } else {
-        std::fill(mx, mx + CorrectedSingleTrack::kNx, 0.f);
-        std::copy(px, px + std::min(plant_states, int{SingleTrack::kNx}), mx);
-        if (plant_states != SingleTrack::kNx)
-          mx[SingleTrack::kOmegaFront] = mx[SingleTrack::kOmegaRear] = px[state::kVx] / radius;
-      }
-    };
-  } else {
-    throw Error("unknown controller model '" + config.model +
-                "' (valid: autorally-nn, single-track, kinematic, corrected, double-track, full-vehicle)");
-  }
+  setup.controller = build_controller(config, model, cost);
+  setup.model_states = M::kNx;
+  setup.observe = std::move(observe);
   return setup;
+}
+
+ControllerSetup make_controller(const ClosedLoopConfig& config, const AutoRallyCost& cost) {
+  if (config.model == kCorrectedModel)
+    return visit_corrected(config.model_params_yaml, "model", [&](const auto& model, auto observe) {
+      return controller_setup(config, model, cost, std::move(observe));
+    });
+  return with_model(config.model, [&]<class D>() {
+    const typename D::Model model = D::load(model_file<D>(config.model_params_yaml, config.network_npz));
+    return controller_setup(config, model, cost, [model](const float* px, int plant_states, float* mx) {
+      D::from_plant(model, px, plant_states, mx);
+    });
+  }, "controller model");
 }
 
 std::string format_times(const std::vector<double>& times) {
@@ -392,35 +322,13 @@ RunSummary run_closed_loop(const ClosedLoopConfig& config) {
       throw Error("target_speed_schedule entry " + std::to_string(i) +
                   ": times must be finite and ascending, speeds finite");
   }
-  if (config.plant == "single-track")
-    return run_with_plant(config, SingleTrack(single_track_params(config.plant_params_yaml)), track, cost);
-  if (config.plant == "autorally-nn")
-    return run_with_plant(config,
-                          AutoRallyNetwork::load(network_file_or_default(config.network_npz)),
-                          track, cost);
-  if (config.plant == "kinematic") return run_with_plant(config, KinematicBicycle(), track, cost);
-  if (config.plant == "double-track")
-    return run_with_plant(config, DoubleTrack(double_track_params(config.plant_params_yaml)), track, cost);
-  if (config.plant == "full-vehicle")
-    return run_with_plant(config, FullVehicle(full_vehicle_params(config.plant_params_yaml)), track, cost);
-  if (config.plant == "corrected") {
-    if (config.plant_params_yaml.empty()) throw Error("--plant corrected needs --plant-params FILE");
-    const CorrectedModelFile file = load_corrected_model(config.plant_params_yaml);
-    if (file.nominal_model == "double-track")
-      return run_with_plant(config, DoubleTrackWithEffects(DoubleTrack(file.double_track), file.effects), track, cost);
-    if (file.nominal_model == "full-vehicle")
-      return run_with_plant(config, FullVehicleWithEffects(FullVehicle(file.full_vehicle), file.effects), track, cost);
-    if (file.nominal_model == "kinematic")
-      return run_with_plant(config, KinematicWithEffects(KinematicBicycle(file.kinematic), file.effects), track, cost);
-    if (file.nominal_model == "autorally-nn")
-      return run_with_plant(config,
-                            AutoRallyNetworkWithEffects(AutoRallyNetwork::load(network_file_or_default(file.network_npz)),
-                                                        file.effects),
-                            track, cost);
-    return run_with_plant(config, CorrectedSingleTrack(file.nominal, file.effects), track, cost);
-  }
-  throw Error("unknown plant '" + config.plant +
-              "' (valid: single-track, autorally-nn, kinematic, corrected, double-track, full-vehicle)");
+  if (config.plant == kCorrectedModel)
+    return visit_corrected(config.plant_params_yaml, "plant", [&](const auto& model, auto) {
+      return run_with_plant(config, model, track, cost);
+    });
+  return with_model(config.plant, [&]<class D>() {
+    return run_with_plant(config, D::load(model_file<D>(config.plant_params_yaml, config.network_npz)), track, cost);
+  }, "plant");
 }
 
 }  // namespace mppi::sim

@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "dynamics/models/autorally_nn.hpp"
+#include "dynamics/models/single_track.hpp"
 #include "mppi/backend_choice.hpp"
 #include "mppi/controller_options.hpp"
 #include "sim/plant.hpp"
@@ -20,8 +22,10 @@ namespace mppi::sim {
 struct ClosedLoopConfig {
   std::string track = "gazebo";           // gazebo | marietta | ccrf
   bool clockwise = false;                 // driving direction (default: counter-clockwise)
-  std::string model = "autorally-nn";     // controller model: autorally-nn | single-track | kinematic
-  std::string plant = "single-track";     // simulated car: single-track | autorally-nn | kinematic
+  // Controller model and simulated car: a registered model's name (mppi::model_names()) or
+  // "corrected" (a corrected-model file of mppi-fit diagnose in model/plant_params_yaml).
+  std::string model = models::AutoRallyNetworkModel::kName;
+  std::string plant = models::SingleTrackModel::kName;
   double target_speed_mps = 6.0;          // v_x^d of the cost
   // A driver's speed schedule: (from time [s], v_x^d [m/s]) steps in ascending time; empty =
   // target_speed_mps throughout. At each step the controller gets the new cost and a fresh plan.
@@ -29,12 +33,12 @@ struct ClosedLoopConfig {
   int laps = 5;                           // stop after this many laps
   double max_time_s = 0.0;                // stop after this much simulated time; 0 = from laps
   ControllerOptions controller;           // K, T, seed, threads, noise, lambda, ...
-  BackendChoice backend = BackendChoice::kCpu;  // rollout backend: cpu | vulkan | auto (kernels/make_controller.hpp)
+  BackendChoice backend = BackendChoice::kCpu;  // rollout backend: cpu | vulkan | auto (mppi/make_controller.hpp)
   BackendReport* backend_report = nullptr;  // if set, receives the backend that ran and why
   std::string cost_params_yaml;           // AutoRally cost weights; empty = data/config default
-  std::string plant_params_yaml;          // single-track parameters; empty = data/config default
-  std::string model_params_yaml;          // controller-model parameters (physics models)
-  std::string network_npz;                // AutoRally network; empty = the 2018 real-car net
+  std::string plant_params_yaml;          // plant's data file; empty = its default (data/config)
+  std::string model_params_yaml;          // controller model's data file; empty = its default
+  std::string network_npz;                // weights (npz) for learned models; empty = the shipped ones
   ActuatorLimits actuators;               // plant actuator limits
   double plant_dt_s = 0.002;              // plant integration step (500 Hz)
   std::string out_dir;                    // log.csv, track.png, summary.json; empty = none

@@ -7,6 +7,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -18,6 +19,7 @@
 #include "costs/cost_map.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
+#include "dynamics/model_registry.hpp"
 #include "mppi/controller.hpp"
 #include "mppi/error.hpp"
 #include "sim/data_dir.hpp"
@@ -61,7 +63,7 @@ double number(const std::string& flag, const std::string& text) {
 int main(int argc, char** argv) {
   using namespace mppi;
   using namespace mppi::chassis;
-  std::string host = "127.0.0.1", name = "mppi", runstop_name = "OCS", model = "autorally-nn",
+  std::string host = "127.0.0.1", name = "mppi", runstop_name = "OCS", model = models::AutoRallyNetworkModel::kName,
               track_name = "gazebo";
   int port = udp::kDefaultPort;
   double speed = 6.0, duration_s = 30.0;
@@ -97,19 +99,17 @@ int main(int argc, char** argv) {
     cost_params.target_speed_mps = static_cast<float>(speed);
     const AutoRallyCost cost(std::make_shared<const CostMap>(CostMap::load_npz(track.costmap_path())),
                              cost_params);
+    // Any registered model with its default data; it reads the chassis' common states.
     std::unique_ptr<Controller> controller;
-    bool rear_axle = false;  // the kinematic bicycle's reference point is the rear axle
-    if (model == "autorally-nn") {
-      controller = std::make_unique<Controller>(make_cpu_controller(
-          AutoRallyNetwork::load(sim::data_file("autorally/models/autorally_nnet_09_12_2018.npz")), cost,
-          options));
-    } else if (model == "kinematic") {
-      controller = std::make_unique<Controller>(make_cpu_controller(KinematicBicycle(), cost, options));
-      rear_axle = true;
-    } else {
-      usage_error("unknown model '" + model + "'");
-    }
-    const float l_r = static_cast<float>(SingleTrackParams{}.cg_to_rear_axle_m);
+    std::function<void(const float* common, float* model_x)> observe;
+    if (!is_registered_model(model)) usage_error("unknown model '" + model + "' (valid: " + model_names() + ")");
+    with_model(model, [&]<class D>() {
+      const std::string default_file = D::kDefaultFile;
+      const typename D::Model m = D::load(default_file.empty() ? default_file : sim::data_file(default_file));
+      controller = std::make_unique<Controller>(make_cpu_controller(m, cost, options));
+      loop_settings.state_size = D::Model::kNx;
+      observe = [m](const float* common, float* model_x) { D::from_plant(m, common, state::kCommonStates, model_x); };
+    });
 
     udp::UdpChassisClient commands(name, host, port);
     udp::UdpChassisClient runstop(runstop_name, host, port);
@@ -138,14 +138,10 @@ int main(int argc, char** argv) {
           if (latest.try_take(&state_msg, &seen)) have_state = true, state_at = clock.now();
           // No state, or none for 0.1 s (the chassis is gone): publish nothing this tick.
           if (!have_state || clock.now() - state_at > seconds(0.1)) return false;
-          std::copy(state_msg.state.begin(), state_msg.state.end(), x.begin());
-          if (!laps_started) laps.reset({x[0], x[1]}, state_msg.time_s), laps_started = true;
-          laps.update({x[0], x[1]}, state_msg.time_s);
-          if (rear_axle) {
-            x[state::kX] -= l_r * std::cos(x[state::kYaw]);
-            x[state::kY] -= l_r * std::sin(x[state::kYaw]);
-            x[state::kVy] = 0.f;
-          }
+          const float* common = state_msg.state.data();
+          if (!laps_started) laps.reset({common[0], common[1]}, state_msg.time_s), laps_started = true;
+          laps.update({common[0], common[1]}, state_msg.time_s);
+          observe(common, x.data());
           return true;
         },
         [&](std::span<const float> x) {

@@ -1,9 +1,8 @@
-// The kinematic bicycle (dynamics/kinematic_bicycle.hpp). Parameters from P_MODEL:
-// 1 / wheelbase, max steer [rad], max acceleration, speed damping.
-#define NX 7
+// The kinematic bicycle (dynamics/kinematic_bicycle.hpp). Its parameters (K_*) and NX are
+// defined by the generated layout_kinematic.glsl from dynamics/models/kinematic.hpp.
 void model_step(inout float x[NX], float steer, float throttle, float dt) {
-  precise float inv_l = PARAM(P_MODEL + 0), max_steer = PARAM(P_MODEL + 1);
-  precise float a_max = PARAM(P_MODEL + 2), damping = PARAM(P_MODEL + 3);
+  precise float inv_l = K_INV_WHEELBASE, max_steer = K_MAX_STEER;
+  precise float a_max = K_MAX_ACCEL, damping = K_DAMPING;
   precise float delta = clampf(steer, -1.0, 1.0) * max_steer;
   precise float sd, cd, sy, cy;
   fast_sincos(delta, sd, cd);

@@ -1,10 +1,14 @@
 // The AutoRally network (dynamics/autorally_nn.hpp): a 6-H1-H2-4 MLP, tanh, tanh, linear, in
-// the library's conventions; explicit Euler. Parameters from P_MODEL, each layer as W (rows
+// the library's conventions; explicit Euler. NX and P_MODEL_TAIL come from the generated
+// layout_autorally_nn.glsl (dynamics/models/autorally_nn.hpp). Parameters from P_MODEL_TAIL,
+// each layer as W (rows
 // padded to a multiple of 4 floats) then b (padded to a multiple of 4), so that a row is read
 // 4 weights per uniform load (lavapipe: one load per weight made the net ~4x slower). The
 // neuron loops are unrolled (hidden sizes are specialization constants), so every read is at a
 // constant offset, and the sums run in the CPU's order: acc = b; acc += w_i a_i, i = 0, 1, ...
-#define NX 7
+// The hidden sizes are the rollout shader's two model constants.
+#define kHidden1 kConstantA
+#define kHidden2 kConstantB
 #define NET_IN 6
 #define NET_OUT 4
 #define PAD4(n) ((((n) + 3) / 4) * 4)
@@ -20,7 +24,7 @@
   }
 
 void model_step(inout float x[NX], float steer, float throttle, float dt) {
-  const int w1 = P_MODEL;
+  const int w1 = P_MODEL_TAIL;
   const int b1 = w1 + kHidden1 * PAD4(NET_IN);
   const int w2 = b1 + PAD4(kHidden1);
   const int b2 = w2 + kHidden2 * PAD4(kHidden1);

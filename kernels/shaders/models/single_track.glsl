@@ -1,29 +1,6 @@
 // The single-track model with Pacejka tyres (dynamics/single_track.hpp, dynamics/pacejka.hpp),
-// float, the same fast math. Parameters from P_MODEL, in SingleTrackCoeffs<float> order.
-#define NX 9
-#define K_INV_MASS PARAM(P_MODEL + 0)
-#define K_INV_IZ PARAM(P_MODEL + 1)
-#define K_LF PARAM(P_MODEL + 2)
-#define K_LR PARAM(P_MODEL + 3)
-#define K_H PARAM(P_MODEL + 4)
-#define K_RADIUS PARAM(P_MODEL + 5)
-#define K_INV_IF PARAM(P_MODEL + 6)
-#define K_INV_IR PARAM(P_MODEL + 7)
-#define K_WEIGHT PARAM(P_MODEL + 8)
-#define K_MAX_STEER PARAM(P_MODEL + 9)
-#define K_STALL PARAM(P_MODEL + 10)
-#define K_INV_NO_LOAD PARAM(P_MODEL + 11)
-#define K_ROLLING PARAM(P_MODEL + 12)
-#define K_INV_ROLLING_SPEED PARAM(P_MODEL + 13)
-#define K_DRAG PARAM(P_MODEL + 14)
-#define K_SLIP_FLOOR PARAM(P_MODEL + 15)
-#define K_INV_SLIP_BLEND PARAM(P_MODEL + 16)
-#define K_B PARAM(P_MODEL + 17)
-#define K_C PARAM(P_MODEL + 18)
-#define K_D PARAM(P_MODEL + 19)
-#define K_E PARAM(P_MODEL + 20)
-#define K_SH PARAM(P_MODEL + 21)
-#define K_SV PARAM(P_MODEL + 22)
+// float, the same fast math. Its parameters (K_*, SingleTrackCoeffs<float>) and NX are defined
+// by the generated layout_single_track.glsl from dynamics/models/single_track.hpp.
 
 float maxf(float a, float b) { return (a < b) ? b : a; }  // std::max
 float minf(float a, float b) { return (b < a) ? b : a; }  // std::min

@@ -1,31 +1,4 @@
-#version 450
-// One invocation = one sample k: draws its perturbed controls with Philox (kGenerate) or reads
-// them (kGenerate = false), steps the model over the horizon and sums the AutoRally running
-// cost, as CpuBackend + Controller::sample do. The model is picked at compile time:
-// -DMODEL_KINEMATIC, -DMODEL_NETWORK or -DMODEL_SINGLE_TRACK (see the *.glsl next to this).
-// Every loop inside a time step has a compile-time trip count and is unrolled, so one
-// invocation runs only T loop iterations (lavapipe silently stops loops after 65,535 in all).
-#extension GL_GOOGLE_include_directive : require
-#extension GL_EXT_control_flow_attributes : require
-
-layout(local_size_x_id = 0) in;
-layout(constant_id = 1) const bool kGenerate = true;  // sample the controls on the device
-layout(constant_id = 2) const int kHidden1 = 32;      // network hidden sizes (network only)
-layout(constant_id = 3) const int kHidden2 = 32;
-
-#include "common.glsl"
-#include "interface.glsl"
-
-#define NU 2
-#if defined(MODEL_KINEMATIC)
-#include "model_kinematic.glsl"
-#elif defined(MODEL_NETWORK)
-#include "model_network.glsl"
-#elif defined(MODEL_SINGLE_TRACK)
-#include "model_single_track.glsl"
-#else
-#error "define MODEL_KINEMATIC, MODEL_NETWORK or MODEL_SINGLE_TRACK"
-#endif
+// The rollout shader, part 2 (after the model): the cost and main(). See rollout_head.glsl.
 #include "cost.glsl"
 
 void main() {

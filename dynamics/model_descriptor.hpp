@@ -1,0 +1,83 @@
+#pragma once
+// A dynamics model declared once: its descriptor (one header under dynamics/models/) gives
+//   using Model;                                    the VehicleDynamics class
+//   static constexpr const char* kName, kSummary;   "single-track", one line for --help
+//   static constexpr const char* kDefaultFile;      data file relative to the data folder
+//                                                   ("" = built-in defaults)
+//   static Model load(const std::string& path);     from a data file; "" = built-in defaults
+//   static std::vector<std::string> state_names();  kNx names, the common states first
+//   static void from_plant(const Model&, const float* plant_x, int plant_states, float* x);
+//                                                   its state from a simulated car's state
+// optionally its YAML parameter table
+//   using Params; static std::vector<ParamField> params(Params&); static Model make(const Params&);
+// and optionally a GPU twin (kernels/): the GLSL file kernels/shaders/models/<kGpuKernel>.glsl
+// and the floats of the parameter block it reads, named as the GLSL code names them
+//   static constexpr const char* kGpuKernel;
+//   static std::vector<GpuField<Model>> gpu_fields();
+//   static bool gpu_tail(const Model&, GpuTail& tail, std::string* why);   (optional: arrays
+//                                                   after the named floats, shader constants)
+// The line MPPI_REGISTER_MODEL(Descriptor) in the header enters it into the compile-time list of
+// models (mppi/generated/model_list.hpp, collected by the build from dynamics/models/*.hpp).
+#include <concepts>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mppi/concepts.hpp"
+#include "mppi/param_table.hpp"
+
+namespace mppi {
+
+// One float of a GPU twin's parameter block: the name the GLSL code reads it by (a #define the
+// build generates) and how to compute it from the model.
+template <class Model>
+struct GpuField {
+  const char* name;
+  float (*value)(const Model&);
+};
+
+// What a GPU twin packs after its named floats: raw arrays (e.g. network weights) and up to two
+// integer shader constants (specialization constants 2 and 3 of the rollout shader).
+struct GpuTail {
+  std::vector<float> floats;
+  int constant_a = 1, constant_b = 1;
+};
+
+template <class D>
+concept ModelDescriptor =
+    VehicleDynamics<typename D::Model> &&
+    requires(const typename D::Model& m, const float* px, float* mx, const std::string& path) {
+      { D::kName } -> std::convertible_to<std::string_view>;
+      { D::kSummary } -> std::convertible_to<std::string_view>;
+      { D::kDefaultFile } -> std::convertible_to<std::string_view>;
+      { D::load(path) } -> std::same_as<typename D::Model>;
+      { D::state_names() } -> std::same_as<std::vector<std::string>>;
+      D::from_plant(m, px, 0, mx);
+    };
+
+template <class D>
+concept HasParamTable = requires(typename D::Params& p) {
+  { D::params(p) } -> std::same_as<std::vector<ParamField>>;
+  { D::make(p) } -> std::same_as<typename D::Model>;
+};
+
+template <class D>
+concept HasGpuTwin = requires {
+  { D::kGpuKernel } -> std::convertible_to<std::string_view>;
+  { D::gpu_fields() } -> std::same_as<std::vector<GpuField<typename D::Model>>>;
+};
+
+template <class D>
+concept HasGpuTail = requires(const typename D::Model& m, GpuTail& t, std::string* why) {
+  { D::gpu_tail(m, t, why) } -> std::same_as<bool>;
+};
+
+// Names for the common states of mppi/vehicle_state.hpp, in order.
+inline std::vector<std::string> common_state_names() {
+  return {"x_m", "y_m", "yaw_rad", "vx_mps", "vy_mps", "yaw_rate_radps", "roll_rad"};
+}
+
+}  // namespace mppi
+
+#define MPPI_REGISTER_MODEL(Descriptor) \
+  static_assert(::mppi::ModelDescriptor<Descriptor>, #Descriptor " is not a complete model descriptor")
