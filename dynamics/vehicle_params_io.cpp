@@ -4,6 +4,10 @@
 #include <string>
 #include <vector>
 
+#include "dynamics/models/double_track.hpp"
+#include "dynamics/models/full_vehicle.hpp"
+#include "dynamics/models/kinematic.hpp"
+#include "dynamics/models/single_track.hpp"
 #include "dynamics/vehicle_params.hpp"
 #include "mppi/error.hpp"
 #include "mppi/param_yaml.hpp"
@@ -37,17 +41,17 @@ std::string yaml_of(const P& p) {
 }  // namespace
 
 SingleTrackParams single_track_params_from_yaml(const std::string& text, const std::string& source) {
-  return params_from_yaml(SingleTrackParams{}, text, source, "single-track");
+  return params_from_yaml(SingleTrackParams{}, text, source, models::SingleTrackModel::kName);
 }
 DoubleTrackParams double_track_params_from_yaml(const std::string& text, const std::string& source) {
-  return params_from_yaml(DoubleTrackParams{}, text, source, "double-track");
+  return params_from_yaml(DoubleTrackParams{}, text, source, models::DoubleTrackModel::kName);
 }
 FullVehicleParams full_vehicle_params_from_yaml(const std::string& text, const std::string& source) {
-  return params_from_yaml(FullVehicleParams{}, text, source, "full-vehicle");
+  return params_from_yaml(FullVehicleParams{}, text, source, models::FullVehicleModel::kName);
 }
 KinematicBicycleParams kinematic_bicycle_params_from_yaml(const std::string& text,
                                                           const std::string& source) {
-  return params_from_yaml(KinematicBicycleParams{}, text, source, "kinematic bicycle");
+  return params_from_yaml(KinematicBicycleParams{}, text, source, models::Kinematic::kName);
 }
 
 SingleTrackParams load_single_track_params(const std::string& path) {
