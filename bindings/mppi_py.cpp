@@ -315,6 +315,14 @@ PYBIND11_MODULE(mppi, m) {
            "one control step from the model state (float32 array of num_states); returns "
            "(control array of num_controls, StepSummary). Releases the GIL.")
       .def("reset", [](PyController& c) { c.controller->reset(); }, "forget the plan")
+      .def("set_cost_param",
+           [](PyController& c, const std::string& key, double value) {
+             std::string why;
+             if (!c.controller->set_cost_param(key, value, &why)) throw mppi::Error(why);
+           },
+           py::arg("key"), py::arg("value"),
+           "change one cost parameter by its YAML key (e.g. 'target_speed_mps') while running; the "
+           "plan is kept. Raises for an unknown key or a value out of range (nothing changes)")
       .def("model_state", [](const PyController& c, const mppi::VehicleState& s) {
         if (!c.init_state) throw mppi::Error("model_state: " + c.model + " is not a vehicle model");
         std::vector<float> x(static_cast<std::size_t>(c.nx), 0.f);

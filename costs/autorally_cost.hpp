@@ -9,10 +9,13 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <string_view>
+#include <vector>
 #include <utility>
 
 #include "costs/cost_map.hpp"
 #include "mppi/batch.hpp"
+#include "mppi/param_table.hpp"
 #include "mppi/error.hpp"
 #include "mppi/vehicle_state.hpp"
 
@@ -62,6 +65,24 @@ struct AutoRallyCostParams {
   }
 };
 
+// The cost's parameter table (YAML key, unit, range, doc): the YAML loader (costs/cost_config.cpp),
+// set_param() and help text come from it. Its ranges are those is_valid() checks.
+inline std::vector<ParamField> param_table(AutoRallyCostParams& p) {
+  return {
+      param("track_weight", &p.track_weight, "1/cost-map unit", non_negative(), "w1: weight of the cost-map value C_M"),
+      param("speed_weight", &p.speed_weight, "s^2/m^2", non_negative(), "w2: weight of (v_x - v_x^d)^2"),
+      param("crash_weight", &p.crash_weight, "-", non_negative(), "w3: cost of a crash at t = 0"),
+      param("slip_weight", &p.slip_weight, "-", non_negative(), "w4: weight of (v_y / v_x)^2"),
+      param("target_speed_mps", &p.target_speed_mps, "m/s", any_finite(), "v_x^d, the desired forward speed"),
+      param("crash_discount", &p.crash_discount, "-", open_low(0, 1), "crash term x crash_discount^t"),
+      param("boundary_threshold", &p.boundary_threshold, "cost-map unit", not_nan(),
+            "cost-map value at/above which the car has left the track"),
+      param("max_roll_rad", &p.max_roll_rad, "rad", positive_or_inf(), "|roll| above which the car rolled over"),
+      param("max_yaw_rate_radps", &p.max_yaw_rate_radps, "rad/s", positive_or_inf(), "|yaw rate| above which the car spins"),
+      param("slip_min_speed_mps", &p.slip_min_speed_mps, "m/s", positive(), "v_x floor of the slip term"),
+  };
+}
+
 // One evaluation split into its weighted terms (total = track + speed + crash + slip, except
 // that a NaN/inf state gives total = +inf).
 struct CostTerms {
@@ -85,6 +106,33 @@ class AutoRallyCost {
   }
 
   const AutoRallyCostParams& params() const noexcept { return params_; }
+
+  // Changes one parameter by its YAML key (e.g. "target_speed_mps") while the controller runs.
+  // False, with the reason in *why, for an unknown key or a value out of range; nothing changes.
+  bool set_param(std::string_view key, double value, std::string* why) {
+    AutoRallyCostParams p = params_;
+    for (const ParamField& f : param_table(p)) {
+      if (key != f.key) continue;
+      f.set(value);
+      if (!in_range(f) || !p.is_valid(why)) {
+        if (why) *why = "cost parameter " + std::string(f.key) + " must be " + range_text(f);
+        return false;
+      }
+      params_ = p;
+      return true;
+    }
+    if (why) *why = "unknown cost parameter '" + std::string(key) + "'";
+    return false;
+  }
+  // A new cost map (e.g. a changed region) while the controller runs.
+  bool set_map(std::shared_ptr<const CostMap> map, std::string* why) {
+    if (!map) {
+      if (why) *why = "the cost map is null";
+      return false;
+    }
+    map_ = std::move(map);
+    return true;
+  }
   const CostMap& map() const noexcept { return *map_; }
   const std::shared_ptr<const CostMap>& map_ptr() const noexcept { return map_; }
 

@@ -93,6 +93,7 @@ struct VulkanBackend::Impl {
   VkFence fence = VK_NULL_HANDLE;
   RolloutShape shape;
   int num_states = 0;
+  std::optional<AutoRallyCost> cost;  // the cost the parameter block holds (changes at run time)
   float dt_s = 0.f;
 
   ~Impl() { destroy(); }
@@ -397,6 +398,7 @@ VulkanBackend::VulkanBackend(const TwinModel& model, const AutoRallyCost& cost, 
   if (static_cast<int>(model.params.size()) + kCostFloats > kParamFloats)
     throw Error("Vulkan backend: the model's " + std::to_string(model.params.size()) +
                 " parameter floats do not fit the 16 KiB uniform buffer");
+  m.cost.emplace(cost);
   float* params = m.buffers[Impl::kParams].f();
   pack_cost(cost, params);
   std::copy(model.params.begin(), model.params.end(), params + kCostFloats);
@@ -456,6 +458,27 @@ void VulkanBackend::iterate(const IterationInput& in, IterationOutput& out) {
   std::copy_n(m.buffers[Impl::kNext].f(), std::min(out.next.size(), static_cast<std::size_t>(shape_.horizon) * kNu), out.next.begin());
   std::copy_n(m.buffers[Impl::kCosts].f(), std::min(out.costs.size(), k), out.costs.begin());
   std::copy_n(m.buffers[Impl::kWeights].f(), std::min(out.weights.size(), k), out.weights.begin());
+}
+
+bool VulkanBackend::set_cost_param(std::string_view key, double value, std::string* why) {
+  Impl& m = *impl_;
+  if (!m.cost->set_param(key, value, why)) return false;
+  // Between submits the device reads nothing: rewrite the cost's floats and the crash costs.
+  pack_cost(*m.cost, m.buffers[Impl::kParams].f());
+  for (int t = 0; t < shape_.horizon; ++t) m.buffers[Impl::kCrash].f()[t] = m.cost->crash_cost_at(t);
+  return true;
+}
+
+bool VulkanBackend::set_cost_map(std::shared_ptr<const CostMap> map, std::string* why) {
+  Impl& m = *impl_;
+  if (map && map->values().size() * sizeof(float) != m.buffers[Impl::kMap].bytes) {
+    if (why) *why = "vulkan backend: a new cost map must have the size of the old one (its buffer is fixed)";
+    return false;
+  }
+  if (!m.cost->set_map(map, why)) return false;
+  std::copy(map->values().begin(), map->values().end(), m.buffers[Impl::kMap].f());
+  pack_cost(*m.cost, m.buffers[Impl::kParams].f());  // the map's bounds and resolution
+  return true;
 }
 
 std::span<const float> VulkanBackend::sampled_controls() const {

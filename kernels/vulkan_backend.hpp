@@ -76,6 +76,8 @@ class VulkanBackend final : public Backend {
   bool has_iterate() const override { return true; }
   void iterate(const IterationInput& in, IterationOutput& out) override;
   std::span<const float> sampled_controls() const override;
+  bool set_cost_param(std::string_view key, double value, std::string* why) override;
+  bool set_cost_map(std::shared_ptr<const CostMap> map, std::string* why) override;
 
  private:
   struct Impl;

@@ -3,7 +3,12 @@
 // from one start state and return each sequence's total running cost. Behind it, models and
 // costs are templates inlined over structure-of-arrays batches (see cpu_backend.hpp).
 #include <cstdint>
+#include <memory>
 #include <span>
+#include <string>
+#include <string_view>
+
+#include "costs/cost_map.hpp"
 
 namespace mppi {
 
@@ -55,6 +60,19 @@ class Backend {
   virtual void iterate(const IterationInput& /*in*/, IterationOutput& /*out*/) {}
   // The controls sampled by the last iterate() (T x nu x padded), if the backend keeps them.
   virtual std::span<const float> sampled_controls() const { return {}; }
+
+  // The cost changed while the controller runs (between iterations, from the thread that
+  // steps it): one parameter by its key, or the cost map. False with the reason in *why if
+  // the cost has no such parameter, the value is out of range, or this backend cannot change
+  // its cost; nothing changes then.
+  virtual bool set_cost_param(std::string_view /*key*/, double /*value*/, std::string* why) {
+    if (why) *why = std::string(name()) + " backend: its cost cannot change while it runs";
+    return false;
+  }
+  virtual bool set_cost_map(std::shared_ptr<const CostMap> /*map*/, std::string* why) {
+    if (why) *why = std::string(name()) + " backend: its cost map cannot change while it runs";
+    return false;
+  }
 };
 
 }  // namespace mppi

@@ -14,6 +14,7 @@
 #include <limits>
 #include <memory>
 #include <span>
+#include <string_view>
 #include <string>
 #include <vector>
 
@@ -139,6 +140,18 @@ class Controller {
     ++step_index_;
     sum.optimizer_ms = elapsed_ms(start);
     return output_;
+  }
+
+  // Change the cost while running, keeping the warm-started plan: one parameter by its key
+  // (AutoRallyCost: the keys of data/config/autorally_cost.yaml, e.g. "target_speed_mps"), or
+  // the cost map. Call between steps, from the thread that steps. False, with the reason in
+  // *why, if the key is unknown, the value out of range or the backend cannot change its cost;
+  // the cost is then unchanged.
+  bool set_cost_param(std::string_view key, double value, std::string* why = nullptr) {
+    return backend_->set_cost_param(key, value, why);
+  }
+  bool set_cost_map(std::shared_ptr<const CostMap> map, std::string* why = nullptr) {
+    return backend_->set_cost_map(std::move(map), why);
   }
 
   // Forget the plan: nominal = zero controls clamped to the limits.

@@ -64,6 +64,15 @@ class CpuBackend final : public Backend {
   const D& model() const { return model_; }
   const C& cost() const { return cost_; }
 
+  bool set_cost_param(std::string_view key, double value, std::string* why) override {
+    if constexpr (requires { cost_.set_param(key, value, why); }) return cost_.set_param(key, value, why);
+    else return Backend::set_cost_param(key, value, why);
+  }
+  bool set_cost_map(std::shared_ptr<const CostMap> map, std::string* why) override {
+    if constexpr (requires { cost_.set_map(map, why); }) return cost_.set_map(std::move(map), why);
+    else return Backend::set_cost_map(std::move(map), why);
+  }
+
   void rollout(std::span<const float> x0, std::span<const float> controls,
                std::span<float> costs) override {
     const int padded = shape_.padded_samples;

@@ -1,5 +1,6 @@
 #include "mppi/param_yaml.hpp"
 
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <set>
@@ -28,6 +29,17 @@ std::string key_list(const std::vector<ParamField>& fields, const std::string& p
   return out;
 }
 
+// True if the field's range takes an infinity (so the YAML reader must accept .inf).
+bool in_range_at_infinity(const ParamField& f) {
+  ParamField probe = f;
+  double v = kInf;
+  probe.value = &v;
+  probe.value_f = nullptr;
+  if (in_range(probe)) return true;
+  v = -kInf;
+  return in_range(probe);
+}
+
 void read_map(const YAML::Node& map, const std::vector<ParamField>& fields, const std::string& prefix,
               const std::string& source, const std::string& what) {
   if (!map.IsMap())
@@ -52,7 +64,7 @@ void read_map(const YAML::Node& map, const std::vector<ParamField>& fields, cons
     }
     if (!target)
       throw Error(at + ": unknown key '" + key + "' in " + what + " (known: " + key_list(fields, prefix) + ")");
-    *target->value = yaml_number(item.second, key, source);
+    target->set(yaml_number(item.second, key, source, /*allow_infinite=*/in_range_at_infinity(*target)));
     if (!in_range(*target))
       throw Error(yaml_where(source, item.second.Mark()) + ": key '" + key + "' must be " +
                   range_text(*target) + " (" + what + ")");
@@ -73,6 +85,15 @@ void read_param_yaml(const std::vector<ParamField>& fields, const std::string& t
   read_map(root, fields, "", source, what);
 }
 
+// A number as YAML writes it (.inf, -.inf for the infinities some ranges allow).
+std::string yaml_scalar(double v) {
+  if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
+  std::ostringstream s;
+  s.precision(17);
+  s << v;
+  return s.str();
+}
+
 std::string write_param_yaml(const std::vector<ParamField>& fields) {
   std::ostringstream out;
   out.precision(17);
@@ -82,7 +103,7 @@ std::string write_param_yaml(const std::vector<ParamField>& fields) {
     const std::string key = f.key;
     const auto dot = key.find('.');
     if (dot == std::string::npos) {
-      out << key << ": " << *f.value << "\n";
+      out << key << ": " << yaml_scalar(f.get()) << "\n";
     } else {
       const std::string group = key.substr(0, dot);
       bool known = false;
@@ -95,7 +116,7 @@ std::string write_param_yaml(const std::vector<ParamField>& fields) {
     for (const ParamField& f : fields) {
       const std::string key = f.key;
       if (key.compare(0, group.size() + 1, group + ".") == 0)
-        out << "  " << key.substr(group.size() + 1) << ": " << *f.value << "\n";
+        out << "  " << key.substr(group.size() + 1) << ": " << yaml_scalar(f.get()) << "\n";
     }
   }
   return out.str();

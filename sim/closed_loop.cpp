@@ -215,10 +215,10 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
     const auto& schedule = config.target_speed_schedule;
     if (next_target < schedule.size() && t + 1e-9 >= schedule[next_target].first) {
       while (next_target + 1 < schedule.size() && t + 1e-9 >= schedule[next_target + 1].first) ++next_target;
-      AutoRallyCostParams p = cost.params();
-      p.target_speed_mps = static_cast<float>(schedule[next_target].second);
-      setup = make_controller(config, AutoRallyCost(cost.map_ptr(), p));
-      controller = setup.controller.get();
+      // The controller keeps its warm-started plan; only the cost's target changes.
+      std::string why;
+      if (!controller->set_cost_param("target_speed_mps", schedule[next_target].second, &why))
+        throw Error("target_speed_schedule entry " + std::to_string(next_target) + ": " + why);
       ++next_target;
     }
     setup.observe(plant.state(), P::kNx, model_x.data());

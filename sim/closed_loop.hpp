@@ -28,7 +28,8 @@ struct ClosedLoopConfig {
   std::string plant = models::SingleTrackModel::kName;
   double target_speed_mps = 6.0;          // v_x^d of the cost
   // A driver's speed schedule: (from time [s], v_x^d [m/s]) steps in ascending time; empty =
-  // target_speed_mps throughout. At each step the controller gets the new cost and a fresh plan.
+  // target_speed_mps throughout. At each step the running controller's cost changes
+  // (Controller::set_cost_param); its warm-started plan is kept.
   std::vector<std::pair<double, double>> target_speed_schedule;
   int laps = 5;                           // stop after this many laps
   double max_time_s = 0.0;                // stop after this much simulated time; 0 = from laps

@@ -171,6 +171,31 @@ def test_same_seed_same_controls_and_errors():
     assert cmap.lookup(np.array([-8.5], np.float32), np.array([-8.9], np.float32))[0] == pytest.approx(0.0)
 
 
+def test_cost_parameters_change_while_running():
+    cmap = mppi.CostMap.load_npz(os.path.join(DATA, "autorally/maps/gazebo/gazebo_costmap.npz"))
+    o = mppi.ControllerOptions()
+    o.num_samples = 256
+    o.num_threads = 1
+    a = mppi.Controller("double-track", mppi.AutoRallyCost(cmap), o)  # any registered model
+    params = mppi.AutoRallyCostParams()
+    params.target_speed_mps = 9.0
+    b = mppi.Controller("double-track", mppi.AutoRallyCost(cmap, params), o)
+    x = a.model_state(mppi.VehicleState(x_m=-8.5, y_m=-8.9, yaw_rad=2.356, vx_mps=5.0))
+    # a's cost changes before its first step: from then on it is b
+    a.set_cost_param("target_speed_mps", 9.0)
+    for _ in range(3):
+        ua, _ = a.step(x)
+        ub, _ = b.step(x)
+        assert np.array_equal(ua, ub)
+    with pytest.raises(mppi.Error, match="unknown cost parameter"):
+        a.set_cost_param("target_speed", 9.0)
+    with pytest.raises(mppi.Error, match="speed_weight"):
+        a.set_cost_param("speed_weight", -1.0)
+    ua, _ = a.step(x)
+    ub, _ = b.step(x)
+    assert np.array_equal(ua, ub)  # the refused changes changed nothing
+
+
 def test_run_closed_loop_releases_the_gil():
     config = sim_config()
     config.laps = 1
