@@ -39,6 +39,31 @@ auto with_model(std::string_view name, F&& f, const char* what = "model") {
   }
 }
 
+// For --help: every registered model with its summary, default data file, states and (for
+// models with a parameter table) each parameter's key, default, unit, range and meaning.
+inline std::string models_help() {
+  std::string out;
+  for_each_type(RegisteredModels{}, [&]<class D>() {
+    out += std::string(D::kName) + ": " + D::kSummary + "\n";
+    const std::string file = D::kDefaultFile;
+    out += "  data file: " + (file.empty() ? std::string("(built-in defaults)") : "data/" + file) + "\n";
+    out += "  states:";
+    for (const std::string& s : D::state_names()) out += " " + s;
+    out += "\n";
+    if constexpr (HasParamTable<D>) {
+      typename D::Params defaults{};
+      out += "  parameters (YAML key = default [unit], valid range: meaning):\n";
+      const std::string table = param_help(D::params(defaults));  // lines "  key = ..."
+      for (std::size_t begin = 0, end; begin < table.size(); begin = end + 1) {
+        end = table.find('\n', begin);
+        out += "  " + table.substr(begin, end - begin + 1);
+      }
+    }
+    if constexpr (HasGpuTwin<D>) out += std::string("  GPU twin: kernels/shaders/models/") + D::kGpuKernel + ".glsl\n";
+  });
+  return out;
+}
+
 // The descriptor whose Model is M (void if M is not a registered model).
 template <class M, class List>
 struct DescriptorOfImpl {

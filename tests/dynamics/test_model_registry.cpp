@@ -169,3 +169,11 @@ TEST_CASE("parameter tables: a value out of range is refused where it is written
                              Catch::Contains("in (0, 2)"));
   }
 }
+
+TEST_CASE("registry: the help text lists every model and its parameters with units", "[registry]") {
+  const std::string help = mppi::models_help();
+  mppi::for_each_type(mppi::RegisteredModels{}, [&]<class D>() { CHECK_THAT(help, Catch::Contains(std::string(D::kName) + ": ")); });
+  CHECK_THAT(help, Catch::Contains("    mass_kg = 21.88 [kg], > 0: total mass m"));
+  CHECK_THAT(help, Catch::Contains("    tyre.C = "));
+  CHECK_THAT(help, Catch::Contains("data/config/autorally_double_track.yaml"));
+}
