@@ -20,6 +20,7 @@ configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/mppiConfig.cmake.in
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/mppiConfigVersion.cmake
   VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/mppiConfig.cmake ${PROJECT_BINARY_DIR}/mppiConfigVersion.cmake
+              ${PROJECT_SOURCE_DIR}/cmake/mppi_installed_data_dir.cpp.in
         DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/mppi)
 
 # The estimation part (sysid/), when built: its headers and library join the package.

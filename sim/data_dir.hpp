@@ -1,6 +1,8 @@
 #pragma once
 // Where the simulator finds its data files (cost maps, track boundaries, model weights):
-// $MPPI_DATA_DIR if set, else the data/ folder of the source tree (fixed at build time).
+// $MPPI_DATA_DIR if set; else, in a program built against an installed package
+// (find_package(mppi)), that installation's share/mppi/data wherever it was installed or
+// copied to; else the data/ folder of the source tree (the build tree's programs).
 #include <string>
 
 namespace mppi::sim {
