@@ -5,6 +5,7 @@
 #include <string>
 
 #include "mppi/error.hpp"
+#include "dynamics/model_registry.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/summary.hpp"
 
@@ -13,12 +14,10 @@ namespace {
 const char* kUsage = R"(usage: mppi-sim [options]
   --track NAME         gazebo | marietta | ccrf                      (default gazebo)
   --clockwise          drive clockwise (default counter-clockwise)
-  --model NAME         controller model: autorally-nn | single-track | kinematic | corrected
-                       (autorally-nn; corrected = nominal + effects from mppi-fit diagnose)
-                       | double-track | full-vehicle (four-wheel physics models)
-  --plant NAME         simulated car: single-track | autorally-nn | kinematic | corrected
-                       (single-track)
-                       | double-track | full-vehicle (four-wheel physics models)
+  --model NAME         controller model: a model below, or corrected (a nominal model +
+                       effects from mppi-fit diagnose, in --model-params)   (autorally-nn)
+  --plant NAME         simulated car: a model below, or corrected            (single-track)
+  --list-models        every model with its data file, states and parameters
   --speed MPS          target speed [m/s]                            (6)
   --laps N             laps to drive                                 (5)
   --max-time S         stop after S simulated seconds (default: from the laps)
@@ -33,10 +32,9 @@ const char* kUsage = R"(usage: mppi-sim [options]
                        there is one, else the CPU; vulkan also takes a CPU Vulkan
                        device (lavapipe); MPPI_VULKAN_DEVICE=<index|name> picks one (auto)
   --cost-config FILE   AutoRally cost weights (YAML)
-  --plant-params FILE  single-track plant parameters (YAML; corrected-model file for corrected)
-                       (double-track / full-vehicle: their YAML, data/config/autorally_*.yaml)
-  --model-params FILE  physics controller-model parameters (YAML; corrected-model file for corrected)
-  --network FILE       AutoRally network (.npz)
+  --plant-params FILE  the plant's data file (YAML parameters, or a corrected-model file)
+  --model-params FILE  the controller model's data file (the same kinds)
+  --network FILE       weights (.npz) of a learned model, when no --*-params file is given
   --out DIR            write DIR/log.csv, DIR/track.png, DIR/summary.json (default out/sim)
   --json               print summary.json to stdout
   --quiet              no progress lines
@@ -79,6 +77,10 @@ int main(int argc, char** argv) {
     };
     if (flag == "--help" || flag == "-h") {
       std::fputs(kUsage, stdout);
+      std::printf("\nmodels: %s\n", mppi::model_names().c_str());
+      return 0;
+    } else if (flag == "--list-models") {
+      std::fputs(mppi::models_help().c_str(), stdout);
       return 0;
     } else if (flag == "--track") config.track = value();
     else if (flag == "--clockwise") config.clockwise = true;
