@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mppi/error.hpp"
+#include "dynamics/model_registry.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/recording.hpp"
@@ -83,7 +84,7 @@ std::vector<std::string> split_list(const std::string& s) {
 }
 
 int cmd_diagnose(int argc, char** argv) {
-  std::string log, params, validate, model = "single-track";
+  std::string log, params, validate, model = mppi::models::SingleTrackModel::kName;
   DiagnoseOptions o;
   o.out_dir = "out/diagnose";
   for (int i = 1; i < argc; ++i) {
@@ -253,7 +254,7 @@ int cmd_loop(int argc, char** argv) {
   base.actuators.throttle_rate_per_s = 1e4f;
   std::string truth_text, model_params, out = "out/diagnose_loop";
   int seeds = 0;  // 0 = the one --seed
-  std::string nominal = "single-track";  // the plant's base and the nominal controller's model
+  std::string nominal = mppi::models::SingleTrackModel::kName;  // the plant's base and the nominal controller's model
   for (int i = 2; i < argc; ++i) {
     const std::string f = argv[i];
     auto value = [&]() -> std::string {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "dynamics/vehicle_params.hpp"
+#include "dynamics/model_registry.hpp"
 #include "mppi/error.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"
@@ -87,7 +88,7 @@ std::string resolve(const std::string& spec) {
 int mppi_fit_estimate(int argc, char** argv) {
   using namespace mppi;
   using namespace mppi::sysid;
-  std::string input, model = "single-track", params_file, out_dir = "out/estimate", truth_file, val_file;
+  std::string input, model = mppi::models::SingleTrackModel::kName, params_file, out_dir = "out/estimate", truth_file, val_file;
   std::vector<std::string> estimate_names;
   EstimateSettings st;
   bool have_fit = false, have_val = false, list_params = false, observe = false, keep_wheelbase = false;
@@ -105,7 +106,7 @@ int mppi_fit_estimate(int argc, char** argv) {
         return 0;
       } else if (a == "--model") {
         model = value();
-        if (model != "single-track" && model != "double-track" && model != "full-vehicle")
+        if (model != mppi::models::SingleTrackModel::kName && model != mppi::models::DoubleTrackModel::kName && model != mppi::models::FullVehicleModel::kName)
           throw Error("--model expects single-track, double-track or full-vehicle, got '" + model + "'");
       } else if (a == "--params") {
         params_file = value();
@@ -164,8 +165,8 @@ int mppi_fit_estimate(int argc, char** argv) {
       }
     }
     if (list_params) {
-      for (const auto& n : model == "single-track"   ? single_track_param_names()
-                           : model == "double-track" ? double_track_param_names()
+      for (const auto& n : model == mppi::models::SingleTrackModel::kName   ? single_track_param_names()
+                           : model == mppi::models::DoubleTrackModel::kName ? double_track_param_names()
                                                      : full_vehicle_param_names())
         std::printf("%s\n", n.c_str());
       return 0;
@@ -187,14 +188,14 @@ int mppi_fit_estimate(int argc, char** argv) {
     // Model and its base parameters.
     VehicleModelSpec spec, truth_spec;
     bool have_truth = !truth_file.empty();
-    if (model == "single-track") {
+    if (model == mppi::models::SingleTrackModel::kName) {
       const SingleTrackParams base = load_single_track_params(
           params_file.empty() ? sim::data_file("config/autorally_single_track.yaml") : params_file);
       if (estimate_names.empty())
         estimate_names = {"yaw_inertia_kgm2", "cg_to_front_axle_m", "tyre.B", "tyre.C", "tyre.D"};
       spec = single_track_spec(base, estimate_names, keep_wheelbase);
       if (have_truth) truth_spec = single_track_spec(load_single_track_params(truth_file), estimate_names);
-    } else if (model == "double-track") {
+    } else if (model == mppi::models::DoubleTrackModel::kName) {
       const DoubleTrackParams base = load_double_track_params(
           params_file.empty() ? sim::data_file("config/autorally_double_track.yaml") : params_file);
       if (estimate_names.empty())
@@ -289,9 +290,9 @@ int mppi_fit_estimate(int argc, char** argv) {
     }
     // The file must load in the simulator and the controller: parse it back with their loader.
     try {
-      if (model == "single-track")
+      if (model == mppi::models::SingleTrackModel::kName)
         (void)load_single_track_params(out_dir + "/estimated.yaml");
-      else if (model == "double-track")
+      else if (model == mppi::models::DoubleTrackModel::kName)
         (void)load_double_track_params(out_dir + "/estimated.yaml");
       else
         (void)load_full_vehicle_params(out_dir + "/estimated.yaml");

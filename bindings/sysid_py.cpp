@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "dynamics/vehicle_params.hpp"
+#include "dynamics/model_registry.hpp"
 #include "mppi/error.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/recording.hpp"
@@ -66,17 +67,17 @@ mppi::sim::Recording load(const std::string& spec) {
 
 // ---- estimation: the model spec as mppi-fit estimate builds it ----
 const char* default_params_file(const std::string& model) {
-  if (model == "single-track") return "config/autorally_single_track.yaml";
-  if (model == "double-track") return "config/autorally_double_track.yaml";
-  if (model == "full-vehicle") return "config/autorally_full_vehicle.yaml";
+  if (model == mppi::models::SingleTrackModel::kName) return "config/autorally_single_track.yaml";
+  if (model == mppi::models::DoubleTrackModel::kName) return "config/autorally_double_track.yaml";
+  if (model == mppi::models::FullVehicleModel::kName) return "config/autorally_full_vehicle.yaml";
   throw mppi::Error("model: expects single-track, double-track or full-vehicle, got '" + model + "'");
 }
 
 std::vector<std::string> default_estimated(const std::string& model) {
-  if (model == "single-track") return {"yaw_inertia_kgm2", "cg_to_front_axle_m", "tyre.B", "tyre.C", "tyre.D"};
+  if (model == mppi::models::SingleTrackModel::kName) return {"yaw_inertia_kgm2", "cg_to_front_axle_m", "tyre.B", "tyre.C", "tyre.D"};
   std::vector<std::string> n = {"mass_kg", "yaw_inertia_kgm2", "rear_wheel_inertia_kgm2", "cg_height_m",
                                 "cg_to_front_axle_m", "tyre.B", "tyre.C", "tyre.D"};
-  if (model == "full-vehicle") n.insert(n.end(), {"front_damper_Nspm", "rear_damper_Nspm"});
+  if (model == mppi::models::FullVehicleModel::kName) n.insert(n.end(), {"front_damper_Nspm", "rear_damper_Nspm"});
   return n;
 }
 
@@ -85,8 +86,8 @@ mppi::sysid::VehicleModelSpec make_spec(const std::string& model, const std::str
   using namespace mppi::sysid;
   const std::string file = params_file.empty() ? mppi::sim::data_file(default_params_file(model)) : params_file;
   if (names.empty()) names = default_estimated(model);
-  if (model == "single-track") return single_track_spec(mppi::load_single_track_params(file), names, keep_wheelbase);
-  if (model == "double-track") return double_track_spec(mppi::load_double_track_params(file), names, keep_wheelbase);
+  if (model == mppi::models::SingleTrackModel::kName) return single_track_spec(mppi::load_single_track_params(file), names, keep_wheelbase);
+  if (model == mppi::models::DoubleTrackModel::kName) return double_track_spec(mppi::load_double_track_params(file), names, keep_wheelbase);
   return full_vehicle_spec(mppi::load_full_vehicle_params(file), names, keep_wheelbase);
 }
 
@@ -434,11 +435,11 @@ void register_sysid(py::module_& m) {
   // ---- estimation ----
   m.def("estimation_param_names", [](const std::string& model) {
     (void)default_params_file(model);  // validates the name
-    return model == "single-track" ? single_track_param_names()
-           : model == "double-track" ? double_track_param_names()
+    return model == mppi::models::SingleTrackModel::kName ? single_track_param_names()
+           : model == mppi::models::DoubleTrackModel::kName ? double_track_param_names()
                                      : full_vehicle_param_names();
-  }, py::arg("model") = "single-track", "parameter names the model can estimate (mppi-fit estimate --list-params)");
-  m.def("estimate_parameters", &estimate, py::arg("recording"), py::arg("model") = "single-track",
+  }, py::arg("model") = mppi::models::SingleTrackModel::kName, "parameter names the model can estimate (mppi-fit estimate --list-params)");
+  m.def("estimate_parameters", &estimate, py::arg("recording"), py::arg("model") = mppi::models::SingleTrackModel::kName,
         py::arg("params_file") = "", py::arg("estimate") = std::vector<std::string>{}, py::arg("estimator") = "alm",
         py::arg("alm_window_s") = 10.0, py::arg("alm_process") = false, py::arg("fit") = py::none(),
         py::arg("measure") = std::vector<std::string>{}, py::arg("meas_std") = std::map<std::string, double>{},
@@ -450,7 +451,7 @@ void register_sysid(py::module_& m) {
         "{name: array over t}, convergence_s {final_5pct, final_2pct[, truth_5pct, truth_2pct]: arrays, s from "
         "the fit start, inf = never}, measured, innovation_rms, measurement_std, steps, projections, "
         "rejected_steps, wall_s, yaml (the estimated parameter file). Releases the GIL.");
-  m.def("validate_parameters", &validate, py::arg("recording"), py::arg("model") = "single-track",
+  m.def("validate_parameters", &validate, py::arg("recording"), py::arg("model") = mppi::models::SingleTrackModel::kName,
         py::arg("params_file") = "", py::arg("values") = std::map<std::string, double>{},
         py::arg("window") = py::none(), py::arg("horizon_s") = 1.0,
         "open-loop simulation of the model (params_file with values {name: value} set) over the rows with t in "
@@ -461,7 +462,7 @@ void register_sysid(py::module_& m) {
   m.def("diagnose", &diagnose, py::arg("log"), py::arg("params") = "", py::arg("holdout") = "0.3",
         py::arg("validate") = "", py::arg("effects") = std::vector<std::string>{}, py::arg("max_effects") = 3,
         py::arg("min_improvement") = 0.03, py::arg("min_bic_drop") = 2.0, py::arg("out_dir") = "",
-        py::arg("plots") = true, py::arg("model") = "single-track",
+        py::arg("plots") = true, py::arg("model") = mppi::models::SingleTrackModel::kName,
         "sim-vs-real diagnosis as mppi-fit diagnose: log (recording or raw real one), model (nominal: "
         "single-track, double-track or full-vehicle), params (that model's YAML or a corrected-model file; "
         "'' = library defaults). Returns {selected, final_params, "

@@ -7,6 +7,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "dynamics/corrected_single_track.hpp"
+#include "dynamics/model_registry.hpp"
 #include "mppi/error.hpp"
 #include "mppi/yaml_number.hpp"
 
@@ -95,15 +96,15 @@ CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std:
     }
   }
   const std::string where = source + " (nominal_params)";
-  if (out.nominal_model == "double-track") {
+  if (out.nominal_model == mppi::models::DoubleTrackModel::kName) {
     if (!nominal_text.empty()) out.double_track = double_track_params_from_yaml(nominal_text, where);
     out.nominal = out.double_track.base;
-  } else if (out.nominal_model == "full-vehicle") {
+  } else if (out.nominal_model == mppi::models::FullVehicleModel::kName) {
     if (!nominal_text.empty()) out.full_vehicle = full_vehicle_params_from_yaml(nominal_text, where);
     out.nominal = out.full_vehicle.base;
-  } else if (out.nominal_model == "kinematic") {
+  } else if (out.nominal_model == mppi::models::Kinematic::kName) {
     if (!nominal_text.empty()) out.kinematic = kinematic_bicycle_params_from_yaml(nominal_text, where);
-  } else if (out.nominal_model == "autorally-nn") {
+  } else if (out.nominal_model == mppi::models::AutoRallyNetworkModel::kName) {
     if (!nominal_text.empty()) {
       if (!nominal_node.IsMap()) throw Error(where + ": expected a map with network_npz");
       for (const auto& kv : nominal_node) {
@@ -145,18 +146,18 @@ std::string corrected_model_to_yaml(const CorrectedModelFile& m, const std::stri
   for (const auto& f : kEffectFields)
     if (m.effects.*(f.member) != defaults.*(f.member)) eff << "  " << f.key << ": " << m.effects.*(f.member) << "\n";
   o << (eff.str().empty() ? "effects: {}\n" : "effects:\n" + eff.str());
-  if (m.nominal_model == "kinematic") {
+  if (m.nominal_model == mppi::models::Kinematic::kName) {
     const KinematicBicycleParams& k = m.kinematic;
     o << "nominal_params:\n  wheelbase_m: " << k.wheelbase_m << "\n  max_steer_rad: " << k.max_steer_rad
       << "\n  max_accel_mps2: " << k.max_accel_mps2 << "\n  speed_damping_per_s: " << k.speed_damping_per_s << "\n";
     return o.str();
   }
-  if (m.nominal_model == "autorally-nn") {
+  if (m.nominal_model == mppi::models::AutoRallyNetworkModel::kName) {
     o << "nominal_params:\n  network_npz: \"" << m.network_npz << "\"\n";
     return o.str();
   }
-  if (m.nominal_model == "double-track" || m.nominal_model == "full-vehicle") {
-    std::istringstream lines(m.nominal_model == "double-track" ? to_yaml(m.double_track) : to_yaml(m.full_vehicle));
+  if (m.nominal_model == mppi::models::DoubleTrackModel::kName || m.nominal_model == mppi::models::FullVehicleModel::kName) {
+    std::istringstream lines(m.nominal_model == mppi::models::DoubleTrackModel::kName ? to_yaml(m.double_track) : to_yaml(m.full_vehicle));
     o << "nominal_params:\n";
     for (std::string line; std::getline(lines, line);)
       if (!line.empty() && line[0] != '#') o << "  " << line << "\n";

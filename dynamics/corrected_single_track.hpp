@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "dynamics/single_track.hpp"
+#include "dynamics/model_registry.hpp"
 #include "dynamics/vehicle_params.hpp"
 
 namespace mppi {
@@ -235,7 +236,7 @@ class CorrectedSingleTrack {
 //   that model's keys, for the network `network_npz: PATH` (empty = the shipped AutoRally
 //   network), and the effects wrap it: WithEffects<...>, dynamics/with_effects.hpp)
 struct CorrectedModelFile {
-  std::string nominal_model = "single-track";  // one of kCorrectedNominalModels
+  std::string nominal_model = mppi::models::SingleTrackModel::kName;  // one of kCorrectedNominalModels
   SingleTrackParams nominal;          // single-track: the model; four-wheel: their core
   DoubleTrackParams double_track;     // nominal_model == "double-track"
   FullVehicleParams full_vehicle;     // nominal_model == "full-vehicle"
@@ -244,10 +245,13 @@ struct CorrectedModelFile {
   EffectParams effects;
   std::vector<std::string> selected;  // effect ids (informational, `selected:` list)
 };
-inline constexpr const char* kCorrectedNominalModels = "single-track, double-track, full-vehicle, kinematic, autorally-nn";
+// The registered models a corrected-model file can have as its nominal (the file has a
+// parameter section for each of them).
+using CorrectedNominalModels = TypeList<models::SingleTrackModel, models::DoubleTrackModel, models::FullVehicleModel,
+                                        models::Kinematic, models::AutoRallyNetworkModel>;
+inline const std::string kCorrectedNominalModels = names_of(CorrectedNominalModels{});
 inline bool is_corrected_nominal_model(const std::string& name) {
-  return name == "single-track" || name == "double-track" || name == "full-vehicle" || name == "kinematic" ||
-         name == "autorally-nn";
+  return visit_by_name(CorrectedNominalModels{}, name, []<class D>() {});
 }
 CorrectedModelFile load_corrected_model(const std::string& path);
 CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std::string& source);

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "dynamics/full_vehicle.hpp"
+#include "dynamics/model_registry.hpp"
 #include "mppi/error.hpp"
 #include "sim/plant.hpp"
 
@@ -239,7 +240,7 @@ ProtocolRun run_protocol(const FullVehicleParams& params, const ProtocolOptions&
 
   std::map<std::string, std::string> meta = {
       {"source", "mppi sysid protocol (simulated AutoRally full vehicle, sysid/protocol.cpp)"},
-      {"model", "full-vehicle"},
+      {"model", mppi::models::FullVehicleModel::kName},
       {"truth_parameters", "truth.yaml"},
       {"seed", std::to_string(o.seed)},
       {"sample_rate_hz", num(o.sample_rate_hz)},

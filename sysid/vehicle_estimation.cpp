@@ -7,6 +7,7 @@
 #include <map>
 
 #include "dynamics/double_track.hpp"
+#include "dynamics/model_registry.hpp"
 #include "dynamics/full_vehicle.hpp"
 #include "dynamics/single_track.hpp"
 #include "mppi/error.hpp"
@@ -128,7 +129,7 @@ VehicleModelSpec single_track_spec(const SingleTrackParams& base, const std::vec
   std::string why;
   if (!base.is_valid(&why)) throw Error("single-track base parameters: " + why);
   VehicleModelSpec s;
-  s.kind = "single-track";
+  s.kind = mppi::models::SingleTrackModel::kName;
   s.nx = SingleTrack::kNx;
   s.state_names = {"x", "y", "yaw", "vx", "vy", "yaw_rate", "roll", "omega_front", "omega_rear"};
   s.measurable = {{"x", 0}, {"y", 1}, {"yaw", 2}, {"vx", 3}, {"vy", 4}, {"yaw_rate", 5},
@@ -183,7 +184,7 @@ VehicleModelSpec double_track_spec(const DoubleTrackParams& base, const std::vec
   std::string why;
   if (!base.is_valid(&why)) throw Error("double-track base parameters: " + why);
   VehicleModelSpec s;
-  s.kind = "double-track";
+  s.kind = mppi::models::DoubleTrackModel::kName;
   s.nx = DoubleTrack::kNx;
   s.state_names = {"x", "y", "yaw", "vx", "vy", "yaw_rate", "roll", "omega_lf", "omega_rf", "omega_lr", "omega_rr"};
   s.measurable = {{"x", 0}, {"y", 1}, {"yaw", 2}, {"vx", 3}, {"vy", 4}, {"yaw_rate", 5},
@@ -224,7 +225,7 @@ VehicleModelSpec full_vehicle_spec(const FullVehicleParams& base, const std::vec
   std::string why;
   if (!base.is_valid(&why)) throw Error("full-vehicle base parameters: " + why);
   VehicleModelSpec s;
-  s.kind = "full-vehicle";
+  s.kind = mppi::models::FullVehicleModel::kName;
   s.nx = FullVehicle::kNx;
   s.state_names = {"x", "y", "yaw", "vx", "vy", "yaw_rate", "roll", "omega_lf", "omega_rf", "omega_lr",
                    "omega_rr", "pitch", "heave", "roll_rate", "pitch_rate", "vz"};

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "dynamics/with_effects.hpp"
+#include "dynamics/model_registry.hpp"
 #include "mppi/error.hpp"
 #include "sim/data_dir.hpp"
 
@@ -50,7 +51,7 @@ class SingleTrackFamily final : public ModelFamily {
 
  private:
   SingleTrackParams p_;
-  std::string name_ = "single-track";
+  std::string name_ = mppi::models::SingleTrackModel::kName;
 };
 
 // Any other base: WithEffects<Base> around the nominal model; `file` carries its parameters.
@@ -94,14 +95,14 @@ std::unique_ptr<ModelFamily> model_family_of(const CorrectedModelFile& file) {
   CorrectedModelFile f = file;
   f.effects = {};
   f.selected.clear();
-  if (f.nominal_model == "double-track") return std::make_unique<WrappedFamily<DoubleTrack>>(DoubleTrack(f.double_track), f);
-  if (f.nominal_model == "full-vehicle") return std::make_unique<WrappedFamily<FullVehicle>>(FullVehicle(f.full_vehicle), f);
-  if (f.nominal_model == "kinematic")
+  if (f.nominal_model == mppi::models::DoubleTrackModel::kName) return std::make_unique<WrappedFamily<DoubleTrack>>(DoubleTrack(f.double_track), f);
+  if (f.nominal_model == mppi::models::FullVehicleModel::kName) return std::make_unique<WrappedFamily<FullVehicle>>(FullVehicle(f.full_vehicle), f);
+  if (f.nominal_model == mppi::models::Kinematic::kName)
     return std::make_unique<WrappedFamily<KinematicBicycle>>(KinematicBicycle(f.kinematic), f);
-  if (f.nominal_model == "autorally-nn")
+  if (f.nominal_model == mppi::models::AutoRallyNetworkModel::kName)
     return std::make_unique<WrappedFamily<AutoRallyNetwork>>(
         AutoRallyNetwork::load(sim::network_file_or_default(f.network_npz)), f);
-  if (f.nominal_model != "single-track")
+  if (f.nominal_model != mppi::models::SingleTrackModel::kName)
     throw Error("nominal model '" + f.nominal_model + "' cannot be diagnosed (valid: " + kCorrectedNominalModels + ")");
   return std::make_unique<SingleTrackFamily>(f.nominal);
 }
@@ -111,7 +112,7 @@ std::unique_ptr<ModelFamily> make_model_family(const std::string& model, const s
     throw Error("nominal model '" + model + "' cannot be diagnosed (valid: " + kCorrectedNominalModels + ")");
   CorrectedModelFile f;
   f.nominal_model = model;
-  if (model == "autorally-nn" && !params_path.empty() && params_path.size() > 4 &&
+  if (model == mppi::models::AutoRallyNetworkModel::kName && !params_path.empty() && params_path.size() > 4 &&
       params_path.substr(params_path.size() - 4) == ".npz") {
     f.network_npz = params_path;  // the network's weights
   } else if (!params_path.empty()) {
@@ -120,11 +121,11 @@ std::unique_ptr<ModelFamily> make_model_family(const std::string& model, const s
       f = corrected_model_from_yaml(text, params_path);
       if (f.nominal_model != model)
         throw Error(params_path + ": a corrected model of a " + f.nominal_model + " nominal, but --model is " + model);
-    } else if (model == "double-track") {
+    } else if (model == mppi::models::DoubleTrackModel::kName) {
       f.double_track = double_track_params_from_yaml(text, params_path);
-    } else if (model == "full-vehicle") {
+    } else if (model == mppi::models::FullVehicleModel::kName) {
       f.full_vehicle = full_vehicle_params_from_yaml(text, params_path);
-    } else if (model == "kinematic") {
+    } else if (model == mppi::models::Kinematic::kName) {
       f.kinematic = kinematic_bicycle_params_from_yaml(text, params_path);
     } else {
       f.nominal = single_track_params_from_yaml(text, params_path);

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "mppi/error.hpp"
+#include "dynamics/model_registry.hpp"
 #include "dynamics/with_effects.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/data_dir.hpp"
@@ -123,17 +124,17 @@ sim::Recording drive_open_loop(M truth_model, std::uint64_t seed, double duratio
 
 sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t seed, double duration_s,
                                     const SensorNoise& noise, const std::string& nominal_model) {
-  if (nominal_model == "double-track")
+  if (nominal_model == mppi::models::DoubleTrackModel::kName)
     return drive_open_loop(DoubleTrackWithEffects(DoubleTrack(), truth), seed, duration_s, noise);
-  if (nominal_model == "full-vehicle")
+  if (nominal_model == mppi::models::FullVehicleModel::kName)
     return drive_open_loop(FullVehicleWithEffects(FullVehicle(), truth), seed, duration_s, noise);
-  if (nominal_model == "kinematic")
+  if (nominal_model == mppi::models::Kinematic::kName)
     return drive_open_loop(KinematicWithEffects(KinematicBicycle(), truth), seed, duration_s, noise);
-  if (nominal_model == "autorally-nn")
+  if (nominal_model == mppi::models::AutoRallyNetworkModel::kName)
     return drive_open_loop(
         AutoRallyNetworkWithEffects(AutoRallyNetwork::load(sim::network_file_or_default("")), truth), seed,
         duration_s, noise);
-  if (nominal_model != "single-track")
+  if (nominal_model != mppi::models::SingleTrackModel::kName)
     throw Error("synthesize_open_loop: unknown nominal model '" + nominal_model + "'");
   return drive_open_loop(CorrectedSingleTrack(SingleTrackParams{}, truth), seed, duration_s, noise);
 }

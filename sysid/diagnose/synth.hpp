@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "dynamics/corrected_single_track.hpp"
+#include "dynamics/model_registry.hpp"
 #include "sim/recording.hpp"
 
 namespace mppi::diagnose {
@@ -27,7 +28,7 @@ struct SynthOptions {
   EffectParams truth;                 // hidden effects (defaults = none)
   // The truth's base model (library defaults), one of kCorrectedNominalModels. The driver
   // (MPPI) uses the same model without the effects.
-  std::string nominal_model = "single-track";
+  std::string nominal_model = mppi::models::SingleTrackModel::kName;
   std::vector<std::string> truth_ids; // their ids, written to the metadata
   std::uint64_t seed = 1;             // MPPI and noise seed
   double duration_s = 60.0;           // recording length [s]
@@ -64,7 +65,7 @@ int synthesize(const SynthOptions& o, const std::string& csv_path);
 // nominal_model: the truth's base, "single-track" (CorrectedSingleTrack), or "double-track",
 // "full-vehicle", "kinematic", "autorally-nn" (WithEffects<...>), with the library's defaults.
 sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t seed, double duration_s,
-                                    const SensorNoise& noise = {}, const std::string& nominal_model = "single-track");
+                                    const SensorNoise& noise = {}, const std::string& nominal_model = mppi::models::SingleTrackModel::kName);
 
 // Parses "key=value,key=value" (EffectParams field names, as in the corrected-model file) into
 // `e`; returns the effect ids the keys belong to. Throws mppi::Error for an unknown key.
