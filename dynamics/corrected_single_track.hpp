@@ -238,10 +238,10 @@ class CorrectedSingleTrack {
 struct CorrectedModelFile {
   std::string nominal_model = mppi::models::SingleTrackModel::kName;  // one of kCorrectedNominalModels
   SingleTrackParams nominal;          // single-track: the model; four-wheel: their core
-  DoubleTrackParams double_track;     // nominal_model == "double-track"
-  FullVehicleParams full_vehicle;     // nominal_model == "full-vehicle"
-  KinematicBicycleParams kinematic;   // nominal_model == "kinematic"
-  std::string network_npz;            // nominal_model == "autorally-nn" ("" = the shipped network)
+  DoubleTrackParams double_track;     // nominal_model == double-track
+  FullVehicleParams full_vehicle;     // nominal_model == full-vehicle
+  KinematicBicycleParams kinematic;   // nominal_model == kinematic
+  std::string network_npz;            // nominal_model == autorally-nn ("" = the shipped network)
   EffectParams effects;
   std::vector<std::string> selected;  // effect ids (informational, `selected:` list)
 };

@@ -17,7 +17,7 @@ namespace mppi::sysid {
 // state, the parameters that may be estimated (YAML key names, e.g. "mass_kg", "tyre.B",
 // "front_damper_Nspm"), and a double-precision step with chosen parameter values.
 struct VehicleModelSpec {
-  std::string kind;                       // "single-track" | "double-track" | "full-vehicle"
+  std::string kind;                       // single-track | double-track | full-vehicle
   int nx = 0;
   std::vector<std::string> state_names;
   std::vector<std::pair<std::string, int>> measurable;  // recording column -> state index

@@ -62,8 +62,8 @@ int synthesize(const SynthOptions& o, const std::string& csv_path);
 // A fast open-loop variant for tests: the truth plant (500 Hz, no slew limits) driven on open
 // ground by random steering and throttle (held 0.1-0.5 s, speed kept in about 3-9 m/s), logged at
 // 50 Hz with sensor noise, in the recording format (metadata source "mppi-fit synth").
-// nominal_model: the truth's base, "single-track" (CorrectedSingleTrack), or "double-track",
-// "full-vehicle", "kinematic", "autorally-nn" (WithEffects<...>), with the library's defaults.
+// nominal_model: the truth's base, single-track (CorrectedSingleTrack), or double-track,
+// full-vehicle, kinematic, autorally-nn (WithEffects<...>), with the library's defaults.
 sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t seed, double duration_s,
                                     const SensorNoise& noise = {}, const std::string& nominal_model = mppi::models::SingleTrackModel::kName);
 
