@@ -6,7 +6,7 @@
 // concealed-effect generator and the corrected controller model that mppi-sim loads
 // (`--model corrected --model-params file.yaml`, `--plant corrected --plant-params file.yaml`).
 //
-// Effects (ids of the issue):
+// Effects (their ids in reports and files):
 //   steer_offset, steer_gain    delta = (gain * s_applied + offset) * max_steer
 //   throttle_offset             throttle u_applied + b (a motor dead band when b < 0)
 //   steer_delay, throttle_delay pure delays, rolled out as a chain of kDelayStages first-order

@@ -18,7 +18,7 @@ struct ParamSpec {
 };
 
 struct EffectSpec {
-  std::string id;               // issue id, e.g. "steer_delay"
+  std::string id;               // effect id, e.g. "steer_delay"
   std::string description;      // one line, physical meaning
   std::vector<ParamSpec> params;
   std::vector<double> grid;     // start values searched for params[0] (empty: its default)

@@ -13,7 +13,7 @@ namespace mppi::diagnose {
 // Held-out normalised multi-step RMSE at the headline horizon of one model, scored two ways.
 struct ScoredRmse {
   double measured = 0;  // against the recording (sensor noise on the scored sample included)
-  double clean = 0;     // against the noise-free states (what the RMSE bar is judged on)
+  double clean = 0;     // against the noise-free states (the prediction error itself)
 };
 
 struct SweepRun {
@@ -42,7 +42,7 @@ SweepRun run_sweep_case(const SynthOptions& so, const std::string& csv, const Di
 // One line of JSON per run (ids, selections and every horizon's metrics, three models).
 std::string sweep_run_json(const SweepRun& r);
 
-// The per-case table and the totals against the bars, in Markdown.
+// The per-case table and the totals against the acceptance targets, in Markdown.
 std::string sweep_summary_markdown(const std::vector<SweepRun>& runs);
 
 }  // namespace mppi::diagnose

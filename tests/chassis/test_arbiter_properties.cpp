@@ -20,7 +20,7 @@
 namespace {
 using namespace mppi::chassis;
 
-// ---- the reference model: the rules of the issue, written out plainly ----------------------
+// ---- the reference model: the arbitration rules of docs/CHASSIS.md, written out plainly ----------------------
 struct Event {
   enum Kind { kCommand, kRunstop } kind;
   std::string name;      // sender or runstop source

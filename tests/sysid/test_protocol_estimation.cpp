@@ -45,7 +45,7 @@ TEST_CASE("ALM-UKF on the simulated protocol recovers the full vehicle's paramet
   }
 }
 
-// The issue's "parameters converge within 20 s", shortened to two 20 s cycles (40 s): the car
+// The paper's "parameters converge within 20 s", shortened to two 20 s cycles (40 s): the car
 // of docs/results/estimation/protocol_truth_full_vehicle.yaml, all ten parameters of the
 // documented run, the documented tuning. Oracle: the known true values; each estimate must
 // stay within 5% of its truth from 20 s on (dampers: 15%, see below). The same check on the sequential layout of the
