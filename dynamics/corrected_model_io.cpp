@@ -1,47 +1,19 @@
-// YAML <-> corrected-model file (dynamics/corrected_single_track.hpp), strict like the other
-// parameter readers: unknown keys, non-numbers and invalid values name the file and key.
+// YAML <-> corrected-model file (dynamics/corrected_model.hpp), strict like the other
+// parameter readers: unknown keys, non-numbers and invalid values name the file and key. The
+// effects are read and written through the effect table (dynamics/effects.hpp).
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
 
-#include "dynamics/corrected_single_track.hpp"
+#include "dynamics/corrected_model.hpp"
 #include "dynamics/model_registry.hpp"
 #include "mppi/error.hpp"
+#include "mppi/param_yaml.hpp"
 #include "mppi/yaml_number.hpp"
 
 namespace mppi {
-namespace {
-
-struct EffectField {
-  const char* key;
-  double EffectParams::*member;
-};
-
-constexpr EffectField kEffectFields[] = {
-    {"steer_offset", &EffectParams::steer_offset},
-    {"steer_gain", &EffectParams::steer_gain},
-    {"throttle_offset", &EffectParams::throttle_offset},
-    {"steer_delay_s", &EffectParams::steer_delay_s},
-    {"throttle_delay_s", &EffectParams::throttle_delay_s},
-    {"steer_lag_s", &EffectParams::steer_lag_s},
-    {"throttle_lag_s", &EffectParams::throttle_lag_s},
-    {"aero_drag_kgpm", &EffectParams::aero_drag_kgpm},
-    {"rolling_force_N", &EffectParams::rolling_force_N},
-    {"rolling_viscous_Nspm", &EffectParams::rolling_viscous_Nspm},
-    {"tyre_peak_scale", &EffectParams::tyre_peak_scale},
-    {"tyre_stiffness_scale", &EffectParams::tyre_stiffness_scale},
-    {"grip_scale", &EffectParams::grip_scale},
-    {"grip_change_time_s", &EffectParams::grip_change_time_s},
-    {"cg_height_delta_m", &EffectParams::cg_height_delta_m},
-    {"voltage_sag", &EffectParams::voltage_sag},
-    {"grade_x", &EffectParams::grade_x},
-    {"grade_y", &EffectParams::grade_y},
-};
-
-}  // namespace
-
 CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std::string& source) {
   YAML::Node root;
   try {
@@ -71,22 +43,7 @@ CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std:
       if (nominal_text == "~" || nominal_text == "{}") nominal_text.clear();
       nominal_node = v;
     } else if (key == "effects") {
-      if (!v.IsMap()) throw Error(yaml_where(source, v.Mark()) + ": effects must be a map");
-      for (const auto& e : v) {
-        const std::string name = e.first.as<std::string>();
-        bool found = false;
-        for (const auto& f : kEffectFields)
-          if (name == f.key) {
-            out.effects.*(f.member) = yaml_number(e.second, name, source);
-            found = true;
-          }
-        if (!found) {
-          std::string valid;
-          for (const auto& f : kEffectFields) valid += (valid.empty() ? "" : ", ") + std::string(f.key);
-          throw Error(yaml_where(source, e.first.Mark()) + ": unknown effect parameter '" + name +
-                      "' (valid: " + valid + ")");
-        }
-      }
+      read_param_yaml(param_table(out.effects), v, source, "effects");
     } else if (key == "selected") {
       if (!v.IsSequence()) throw Error(yaml_where(source, v.Mark()) + ": selected must be a list");
       for (const auto& s : v) out.selected.push_back(s.as<std::string>());
@@ -140,43 +97,33 @@ std::string corrected_model_to_yaml(const CorrectedModelFile& m, const std::stri
   o << "model: corrected\nnominal: " << m.nominal_model << "\nselected: [";
   for (std::size_t i = 0; i < m.selected.size(); ++i) o << (i ? ", " : "") << m.selected[i];
   o << "]\n";
-  const EffectParams defaults;
+  // Only the effects that are on (values other than their defaults).
+  EffectParams effects = m.effects, defaults;
+  const std::vector<ParamField> fields = param_table(effects), default_fields = param_table(defaults);
   std::ostringstream eff;
-  eff.precision(10);
-  for (const auto& f : kEffectFields)
-    if (m.effects.*(f.member) != defaults.*(f.member)) eff << "  " << f.key << ": " << m.effects.*(f.member) << "\n";
+  eff.precision(17);
+  for (std::size_t i = 0; i < fields.size(); ++i)
+    if (fields[i].get() != default_fields[i].get()) eff << "  " << fields[i].key << ": " << fields[i].get() << "\n";
   o << (eff.str().empty() ? "effects: {}\n" : "effects:\n" + eff.str());
-  if (m.nominal_model == mppi::models::Kinematic::kName) {
-    const KinematicBicycleParams& k = m.kinematic;
-    o << "nominal_params:\n  wheelbase_m: " << k.wheelbase_m << "\n  max_steer_rad: " << k.max_steer_rad
-      << "\n  max_accel_mps2: " << k.max_accel_mps2 << "\n  speed_damping_per_s: " << k.speed_damping_per_s << "\n";
-    return o.str();
-  }
   if (m.nominal_model == mppi::models::AutoRallyNetworkModel::kName) {
     o << "nominal_params:\n  network_npz: \"" << m.network_npz << "\"\n";
     return o.str();
   }
-  if (m.nominal_model == mppi::models::DoubleTrackModel::kName || m.nominal_model == mppi::models::FullVehicleModel::kName) {
-    std::istringstream lines(m.nominal_model == mppi::models::DoubleTrackModel::kName ? to_yaml(m.double_track) : to_yaml(m.full_vehicle));
-    o << "nominal_params:\n";
-    for (std::string line; std::getline(lines, line);)
-      if (!line.empty() && line[0] != '#') o << "  " << line << "\n";
-    return o.str();
+  std::string nominal_yaml;
+  if (m.nominal_model == mppi::models::Kinematic::kName) {
+    KinematicBicycleParams k = m.kinematic;
+    nominal_yaml = write_param_yaml(param_table(k));
+  } else if (m.nominal_model == mppi::models::DoubleTrackModel::kName) {
+    nominal_yaml = to_yaml(m.double_track);
+  } else if (m.nominal_model == mppi::models::FullVehicleModel::kName) {
+    nominal_yaml = to_yaml(m.full_vehicle);
+  } else {
+    nominal_yaml = to_yaml(m.nominal);
   }
-  const SingleTrackParams& p = m.nominal;
-  o << "nominal_params:\n"
-    << "  mass_kg: " << p.mass_kg << "\n  yaw_inertia_kgm2: " << p.yaw_inertia_kgm2
-    << "\n  cg_to_front_axle_m: " << p.cg_to_front_axle_m << "\n  cg_to_rear_axle_m: " << p.cg_to_rear_axle_m
-    << "\n  cg_height_m: " << p.cg_height_m << "\n  wheel_radius_m: " << p.wheel_radius_m
-    << "\n  front_wheel_inertia_kgm2: " << p.front_wheel_inertia_kgm2
-    << "\n  rear_wheel_inertia_kgm2: " << p.rear_wheel_inertia_kgm2 << "\n  gravity_mps2: " << p.gravity_mps2
-    << "\n  max_steer_rad: " << p.max_steer_rad << "\n  stall_torque_Nm: " << p.stall_torque_Nm
-    << "\n  no_load_speed_mps: " << p.no_load_speed_mps << "\n  rolling_resistance: " << p.rolling_resistance
-    << "\n  rolling_resistance_speed_mps: " << p.rolling_resistance_speed_mps
-    << "\n  aero_drag_kgpm: " << p.aero_drag_kgpm << "\n  slip_speed_floor_mps: " << p.slip_speed_floor_mps
-    << "\n  slip_blend: " << p.slip_blend << "\n  tyre:\n    B: " << p.tyre.B << "\n    C: " << p.tyre.C
-    << "\n    D: " << p.tyre.D << "\n    E: " << p.tyre.E << "\n    Sh: " << p.tyre.Sh << "\n    Sv: " << p.tyre.Sv
-    << "\n";
+  std::istringstream lines(nominal_yaml);
+  o << "nominal_params:\n";
+  for (std::string line; std::getline(lines, line);)
+    if (!line.empty() && line[0] != '#') o << "  " << line << "\n";
   return o.str();
 }
 

@@ -1,42 +1,60 @@
 #pragma once
-// "Nominal + effects" around any other model of the library: WithEffects<DoubleTrack>,
-// <FullVehicle>, <KinematicBicycle>, <AutoRallyNetwork> add the terms that `mppi-fit diagnose`
-// names (the EffectParams of dynamics/corrected_single_track.hpp) around an unchanged base
-// model, so that a diagnosis can start from any of them. The single-track model has its own
-// exact class (CorrectedSingleTrack, effects inside its force balance); here they enter around
-// the base:
-//   - actuator effects (offsets, gain, delays, lags, voltage sag) transform the command first;
-//   - tyre effects (tire_saturation, friction_change, load_transfer) change the base's
-//     single-track core parameters (apply_effect_params), with a second base model for the grip
-//     after a change (time is a state). Only for bases with such a core (the four-wheel
-//     models); the kinematic bicycle and the network have no tyres, so these are refused;
-//   - force effects (aero_drag, rolling_resistance, road_grade) add their acceleration to
-//     v_x (and v_y where the base has a lateral velocity) after the base step (operator
-//     splitting; the step is the plant's 2 ms). Mass: the base's own, or for bases without one
-//     the AutoRally car's (SingleTrackParams defaults; the network models that car).
-// State: the base's kNx, then time [s], then the steer and throttle actuator chains.
+// "Nominal + effects" around any model of the library: WithEffects<SingleTrack>,
+// <DoubleTrack>, <FullVehicle>, <KinematicBicycle>, <AutoRallyNetwork> add the terms that
+// `mppi-fit diagnose` names and fits (the effect table, dynamics/effects.hpp) around an
+// unchanged base model. The same class is the synthetic truth plant of the concealed-effect
+// generator and the corrected model that mppi-sim loads (`--model corrected`). Every effect is
+// off at its default value, so WithEffects<M> with default EffectParams steps exactly like M
+// (plus the bookkeeping states). Each effect enters through its hook:
+//   - actuator: offsets, gain, delays, lags and voltage sag transform the command first;
+//   - tyre: tire_saturation, friction_change and load_transfer change the base's single-track
+//     core parameters (apply_effect_params), with a second base model for the grip after a
+//     change (time is a state). Only for bases with such a core (the single-track and
+//     four-wheel models); the kinematic bicycle and the network have no tyres, so these are
+//     refused;
+//   - force: aero_drag, rolling_resistance and road_grade add an acceleration along the body
+//     axes. A base that offers step_with_body_accel (the single-track model) takes it inside
+//     its force balance; for the others it is added to v_x (and v_y where the base has a
+//     lateral velocity) after the base step (operator splitting over one plant step). Mass: the
+//     base's own, or for bases without one the AutoRally car's (SingleTrackParams defaults; the
+//     network models that car).
+// State: the base's kNx, then time [s], then the steer and throttle actuator chains
+// (kActuatorDelayStages delay stages followed by one lag stage, whose output is applied).
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <string>
 #include <type_traits>
 #include <utility>
 
 #include "dynamics/autorally_nn.hpp"
-#include "dynamics/corrected_single_track.hpp"
 #include "dynamics/double_track.hpp"
+#include "dynamics/effects.hpp"
 #include "dynamics/fast_trig.hpp"
 #include "dynamics/full_vehicle.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
 #include "dynamics/pacejka.hpp"
+#include "dynamics/single_track.hpp"
 #include "mppi/concepts.hpp"
 
 namespace mppi {
 
-// A base whose parameters hold a single-track core (mass, tyres, CG height): tyre effects apply.
+// The single-track core of a model's parameters (mass, tyres, CG height), where it has one.
+inline const SingleTrackParams& single_track_core(const SingleTrackParams& p) { return p; }
+inline SingleTrackParams& single_track_core(SingleTrackParams& p) { return p; }
+template <class P>
+  requires requires(P& p) { { p.base } -> std::convertible_to<SingleTrackParams>; }
+auto& single_track_core(P& p) { return p.base; }
+
+// A base whose parameters hold a single-track core: tyre effects apply.
 template <class Base>
 concept HasSingleTrackCore = requires(const Base& b) {
-  { b.params().base } -> std::convertible_to<SingleTrackParams>;
+  { single_track_core(b.params()) } -> std::convertible_to<SingleTrackParams>;
+};
+
+// A base that takes extra body-axis accelerations inside its force balance.
+template <class Base>
+concept HasBodyAccelHook = requires(const Base& b, Batch<Base::kNx, 1> x, ConstBatch<Base::kNu, 1> u, float* a) {
+  b.template step_with_body_accel<1>(x, u, 0.f, a, a, a);
 };
 
 template <VehicleDynamics Base>
@@ -44,7 +62,8 @@ class WithEffects {
  public:
   static constexpr bool kTyreEffects = HasSingleTrackCore<Base>;
   static constexpr bool kLateralVelocity = !std::is_same_v<Base, KinematicBicycle>;  // it pins v_y = 0
-  static constexpr int kChain = CorrectedSingleTrack::kChain;
+  static constexpr int kDelayStages = kActuatorDelayStages;
+  static constexpr int kChain = kDelayStages + 1;
   static constexpr int kTime = Base::kNx;
   static constexpr int kSteerChain = kTime + 1;
   static constexpr int kThrottleChain = kSteerChain + kChain;
@@ -57,14 +76,12 @@ class WithEffects {
 
   // Throws mppi::Error if the effects are not valid, make the base invalid, or need tyres the
   // base does not have.
-  explicit WithEffects(const Base& nominal, const EffectParams& effects = {})
+  explicit WithEffects(const Base& nominal = Base(), const EffectParams& effects = {})
       : nominal_(nominal), effects_(validated(effects)), before_(with_core(nominal, effects, 1.0)),
         after_(with_core(nominal, effects, effects.grip_scale)) {
-    double m = SingleTrackParams{}.mass_kg, g = SingleTrackParams{}.gravity_mps2;
-    if constexpr (kTyreEffects) {
-      m = nominal_.params().base.mass_kg;
-      g = nominal_.params().base.gravity_mps2;
-    }
+    SingleTrackParams car;  // the AutoRally car, for bases without a mass
+    if constexpr (kTyreEffects) car = single_track_core(nominal_.params());
+    const double m = car.mass_kg, g = car.gravity_mps2;
     drag_per_kg_ = static_cast<float>(effects_.aero_drag_kgpm / m);
     roll_per_kg_ = static_cast<float>(effects_.rolling_force_N / m);
     visc_per_kg_ = static_cast<float>(effects_.rolling_viscous_Nspm / m);
@@ -78,10 +95,22 @@ class WithEffects {
   const EffectParams& effects() const { return effects_; }
   std::size_t scratch_floats(int w) const { return before_.scratch_floats(w); }
 
+  // Advances one actuator chain (kChain floats) by one step with input u; returns the output.
+  static float advance_chain(float* chain, float u, float a_delay, float a_lag) noexcept {
+    float in = u;
+    for (int i = 0; i < kDelayStages; ++i) {
+      chain[i] += a_delay * (in - chain[i]);
+      in = chain[i];
+    }
+    chain[kDelayStages] += a_lag * (in - chain[kDelayStages]);
+    return chain[kDelayStages];
+  }
+
+  // Actuator chains only, one state (used to prime them from a command history).
   void advance_actuators(float* x, float steer, float throttle, float dt_s) const noexcept {
     const ActuatorAlphas al = actuator_alphas(effects_, dt_s);
-    CorrectedSingleTrack::advance_chain(x + kSteerChain, steer, al.steer_delay, al.steer_lag);
-    CorrectedSingleTrack::advance_chain(x + kThrottleChain, throttle, al.throttle_delay, al.throttle_lag);
+    advance_chain(x + kSteerChain, steer, al.steer_delay, al.steer_lag);
+    advance_chain(x + kThrottleChain, throttle, al.throttle_delay, al.throttle_lag);
   }
 
   template <int W>
@@ -90,7 +119,7 @@ class WithEffects {
     const float gain = static_cast<float>(effects_.steer_gain), offset = static_cast<float>(effects_.steer_offset);
     const float sag = static_cast<float>(effects_.voltage_sag), thr_offset = static_cast<float>(effects_.throttle_offset);
     float applied[kNu * W];  // the command the base model sees, per lane
-    float vx0[W], yaw0[W];
+    float ax[W], ay[W];      // force hook: body-axis accelerations from the start-of-step state
     int before_lanes = 0;
     for (int j = 0; j < W; ++j) {
       float chain_s[kChain], chain_t[kChain];
@@ -98,8 +127,8 @@ class WithEffects {
         chain_s[i] = x[kSteerChain + i][j];
         chain_t[i] = x[kThrottleChain + i][j];
       }
-      const float s = CorrectedSingleTrack::advance_chain(chain_s, u[control::kSteer][j], al.steer_delay, al.steer_lag);
-      const float t = CorrectedSingleTrack::advance_chain(chain_t, u[control::kThrottle][j], al.throttle_delay, al.throttle_lag);
+      const float s = advance_chain(chain_s, u[control::kSteer][j], al.steer_delay, al.steer_lag);
+      const float t = advance_chain(chain_t, u[control::kThrottle][j], al.throttle_delay, al.throttle_lag);
       for (int i = 0; i < kChain; ++i) {
         x[kSteerChain + i][j] = chain_s[i];
         x[kThrottleChain + i][j] = chain_t[i];
@@ -107,36 +136,30 @@ class WithEffects {
       const float t_pos = std::max(t, 0.f);
       applied[control::kSteer * W + j] = gain * s + offset;
       applied[control::kThrottle * W + j] = t + thr_offset - sag * t_pos * t_pos;
-      vx0[j] = x[state::kVx][j];
-      yaw0[j] = x[state::kYaw][j];
+      const float vx = x[state::kVx][j];
+      float sy, cy;
+      fast_sincos(x[state::kYaw][j], &sy, &cy);
+      ax[j] = -drag_per_kg_ * vx * std::abs(vx) - roll_per_kg_ * phys::tanh(vx * 2.f) - visc_per_kg_ * vx -
+              (grade_x_ * cy + grade_y_ * sy);
+      ay[j] = -(-grade_x_ * sy + grade_y_ * cy);
       before_lanes += grip_changes_ && x[kTime][j] < change_time_;
     }
     const Batch<Base::kNx, W> xb{x.data};
     const ConstBatch<Base::kNu, W> ub{applied};
     if (before_lanes == 0) {
-      after_.template step<W>(xb, ub, dt_s, scratch);
+      base_step<W>(after_, xb, ub, dt_s, scratch, ax, ay);
     } else if (before_lanes == W) {
-      before_.template step<W>(xb, ub, dt_s, scratch);
+      base_step<W>(before_, xb, ub, dt_s, scratch, ax, ay);
     } else {  // lanes on both sides of a grip change: step both, keep each lane's own
       float copy[Base::kNx * W];
       std::copy(x.data, x.data + Base::kNx * W, copy);
-      before_.template step<W>(Batch<Base::kNx, W>{copy}, ub, dt_s, scratch);
-      after_.template step<W>(xb, ub, dt_s, scratch);
+      base_step<W>(before_, Batch<Base::kNx, W>{copy}, ub, dt_s, scratch, ax, ay);
+      base_step<W>(after_, xb, ub, dt_s, scratch, ax, ay);
       for (int j = 0; j < W; ++j)
         if (x[kTime][j] < change_time_)
           for (int i = 0; i < Base::kNx; ++i) x[i][j] = copy[i * W + j];
     }
-    for (int j = 0; j < W; ++j) {
-      const float vx = vx0[j];
-      float sy, cy;
-      fast_sincos(yaw0[j], &sy, &cy);
-      const float ax = -drag_per_kg_ * vx * std::abs(vx) - roll_per_kg_ * phys::tanh(vx * 2.f) - visc_per_kg_ * vx -
-                       (grade_x_ * cy + grade_y_ * sy);
-      const float ay = -(-grade_x_ * sy + grade_y_ * cy);
-      x[state::kVx][j] += ax * dt_s;
-      if constexpr (kLateralVelocity) x[state::kVy][j] += ay * dt_s;
-      x[kTime][j] += dt_s;
-    }
+    for (int j = 0; j < W; ++j) x[kTime][j] += dt_s;
   }
 
   // The base's start state; time 0; actuators at rest.
@@ -152,15 +175,37 @@ class WithEffects {
   }
 
  private:
+  // One base step with the force hook: inside the base's force balance where it offers that,
+  // else added after its step.
+  template <int W>
+  static void base_step(const Base& base, Batch<Base::kNx, W> x, ConstBatch<Base::kNu, W> u, float dt_s,
+                        float* scratch, const float* ax, const float* ay) noexcept {
+    if constexpr (HasBodyAccelHook<Base>) {
+      base.template step_with_body_accel<W>(x, u, dt_s, scratch, ax, ay);
+    } else {
+      base.template step<W>(x, u, dt_s, scratch);
+      for (int j = 0; j < W; ++j) {
+        x[state::kVx][j] += ax[j] * dt_s;
+        if constexpr (kLateralVelocity) x[state::kVy][j] += ay[j] * dt_s;
+      }
+    }
+  }
+
   static Base with_core(const Base& b, const EffectParams& e, double grip) {
     if constexpr (kTyreEffects) {
       auto p = b.params();
-      p.base = apply_effect_params(p.base, e, grip);
+      single_track_core(p) = apply_effect_params(single_track_core(p), e, grip);
+      std::string why;
+      if (!single_track_core(p).is_valid(&why))
+        throw Error("WithEffects: the effects make the model invalid: " + why);
       return Base(p);
     } else {
-      if (e.tyre_peak_scale != 1.0 || e.tyre_stiffness_scale != 1.0 || e.grip_scale != 1.0 || e.cg_height_delta_m != 0.0)
-        throw Error("WithEffects: tire_saturation, friction_change and load_transfer need a tyre model; this base "
-                    "model has none");
+      for (const EffectSpec& spec : effect_table()) {
+        if (spec.hook != EffectHook::kTyre) continue;
+        for (const EffectParamSpec& q : spec.params)
+          if (e.*(q.member) != EffectParams{}.*(q.member))
+            throw Error("WithEffects: " + spec.id + " needs a tyre model; this base model has none");
+      }
       return b;
     }
   }
@@ -177,6 +222,7 @@ class WithEffects {
   bool grip_changes_ = false;
 };
 
+using CorrectedSingleTrack = WithEffects<SingleTrack>;
 using DoubleTrackWithEffects = WithEffects<DoubleTrack>;
 using FullVehicleWithEffects = WithEffects<FullVehicle>;
 using KinematicWithEffects = WithEffects<KinematicBicycle>;

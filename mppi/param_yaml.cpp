@@ -85,6 +85,12 @@ void read_param_yaml(const std::vector<ParamField>& fields, const std::string& t
   read_map(root, fields, "", source, what);
 }
 
+void read_param_yaml(const std::vector<ParamField>& fields, const YAML::Node& map, const std::string& source,
+                     const std::string& what) {
+  if (!map.IsDefined() || map.IsNull()) return;
+  read_map(map, fields, "", source, what);
+}
+
 // A number as YAML writes it (.inf, -.inf for the infinities some ranges allow).
 std::string yaml_scalar(double v) {
   if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";

@@ -12,9 +12,9 @@
 #include "costs/autorally_cost.hpp"
 #include "costs/cost_config.hpp"
 #include "costs/cost_map.hpp"
-#include "dynamics/corrected_single_track.hpp"
-#include "dynamics/model_registry.hpp"
+#include "dynamics/corrected_model.hpp"
 #include "dynamics/with_effects.hpp"
+#include "dynamics/model_registry.hpp"
 #include "dynamics/four_wheel_observe.hpp"
 #include "mppi/controller.hpp"
 #include "mppi/error.hpp"
@@ -44,58 +44,32 @@ std::string model_file(const std::string& params_file, const std::string& weight
   return default_file.empty() ? std::string() : data_file(default_file);
 }
 
-// The model of a corrected-model file (nominal + effects), handed to f as its concrete type,
-// with how it reads a plant's state.
+// The model of a corrected-model file (nominal + effects, WithEffects<Model>), handed to f as
+// its concrete type, with how it reads a plant's state: a plant of the same corrected model is
+// copied whole; any other as the nominal model reads it, with time 0 and the actuator chains at
+// rest.
 template <class F>
 auto visit_corrected(const std::string& path, const char* flag, F&& f) {
   if (path.empty()) throw Error(std::string("--") + flag + " corrected needs --" + flag + "-params FILE");
   const CorrectedModelFile file = load_corrected_model(path);
-  const std::string& nominal = file.nominal_model;
-  // Other models + effects: read like their base (common states), chains at rest.
-  const auto observe_common = [](int model_states) {
-    return [model_states](const float* px, int plant_states, float* mx) {
-      if (plant_states == model_states) {
-        std::copy(px, px + model_states, mx);
+  using Result = decltype(f(std::declval<const CorrectedSingleTrack&>(),
+                            std::function<void(const float*, int, float*)>()));
+  std::optional<Result> result;
+  visit_by_name(CorrectedNominalModels{}, file.nominal_model, [&]<class D>() {
+    using M = WithEffects<typename D::Model>;
+    const M model(corrected_nominal<D>(file, network_file_or_default(file.network_npz)), file.effects);
+    std::function<void(const float*, int, float*)> observe = [base = model.nominal()](const float* px,
+                                                                                      int plant_states, float* mx) {
+      if (plant_states == M::kNx) {
+        std::copy(px, px + M::kNx, mx);
         return;
       }
-      std::fill(mx, mx + model_states, 0.f);
-      std::copy(px, px + state::kCommonStates, mx);
+      std::fill(mx, mx + M::kNx, 0.f);
+      D::from_plant(base, px, plant_states, mx);
     };
-  };
-  const float radius = static_cast<float>(file.nominal.wheel_radius_m);
-  const auto observe_four_wheel = [radius]<class M>(std::type_identity<M>) {
-    return [radius](const float* px, int plant_states, float* mx) {
-      four_wheel_from_plant<M>(px, plant_states, radius, mx);
-    };
-  };
-  if (nominal == models::Kinematic::kName) {
-    const KinematicWithEffects model(KinematicBicycle(file.kinematic), file.effects);
-    return f(model, observe_common(KinematicWithEffects::kNx));
-  }
-  if (nominal == models::AutoRallyNetworkModel::kName) {
-    const AutoRallyNetworkWithEffects model(AutoRallyNetwork::load(network_file_or_default(file.network_npz)),
-                                            file.effects);
-    return f(model, observe_common(AutoRallyNetworkWithEffects::kNx));
-  }
-  if (nominal == models::DoubleTrackModel::kName) {
-    const DoubleTrackWithEffects model(DoubleTrack(file.double_track), file.effects);
-    return f(model, observe_four_wheel(std::type_identity<DoubleTrackWithEffects>{}));
-  }
-  if (nominal == models::FullVehicleModel::kName) {
-    const FullVehicleWithEffects model(FullVehicle(file.full_vehicle), file.effects);
-    return f(model, observe_four_wheel(std::type_identity<FullVehicleWithEffects>{}));
-  }
-  const CorrectedSingleTrack model(file.nominal, file.effects);
-  return f(model, [radius](const float* px, int plant_states, float* mx) {
-    if (plant_states == CorrectedSingleTrack::kNx) {
-      std::copy(px, px + CorrectedSingleTrack::kNx, mx);
-    } else {
-      std::fill(mx, mx + CorrectedSingleTrack::kNx, 0.f);
-      std::copy(px, px + std::min(plant_states, int{SingleTrack::kNx}), mx);
-      if (plant_states != SingleTrack::kNx)
-        mx[SingleTrack::kOmegaFront] = mx[SingleTrack::kOmegaRear] = px[state::kVx] / radius;
-    }
+    result.emplace(f(model, std::move(observe)));
   });
+  return std::move(*result);
 }
 
 // The controller and how it reads the plant: full plant state -> controller model state.

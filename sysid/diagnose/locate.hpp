@@ -5,7 +5,6 @@
 #include <string>
 #include <vector>
 
-#include "dynamics/corrected_single_track.hpp"
 #include "sysid/diagnose/data.hpp"
 #include "sysid/diagnose/replay.hpp"
 

@@ -34,27 +34,7 @@ class ReplayModelOf final : public ReplayModel {
   mutable std::vector<float> scratch_;  // the model's per-step work space (the network's layers)
 };
 
-class SingleTrackFamily final : public ModelFamily {
- public:
-  explicit SingleTrackFamily(const SingleTrackParams& p) : p_(p) { CorrectedSingleTrack check(p_); }
-  const std::string& name() const override { return name_; }
-  std::unique_ptr<ReplayModel> make(const EffectParams& e) const override {
-    return std::make_unique<ReplayModelOf<CorrectedSingleTrack>>(CorrectedSingleTrack(p_, e));
-  }
-  CorrectedModelFile file(const EffectParams& e, const std::vector<std::string>& selected) const override {
-    CorrectedModelFile f;
-    f.nominal = p_;
-    f.effects = e;
-    f.selected = selected;
-    return f;
-  }
-
- private:
-  SingleTrackParams p_;
-  std::string name_ = mppi::models::SingleTrackModel::kName;
-};
-
-// Any other base: WithEffects<Base> around the nominal model; `file` carries its parameters.
+// WithEffects<Base> around the nominal model; `file` carries its parameters.
 template <class Base>
 class WrappedFamily final : public ModelFamily {
  public:
@@ -66,8 +46,7 @@ class WrappedFamily final : public ModelFamily {
     return std::make_unique<ReplayModelOf<WithEffects<Base>>>(WithEffects<Base>(nominal_, e));
   }
   bool supports(const std::string& effect_id) const override {
-    return WithEffects<Base>::kTyreEffects ||
-           (effect_id != "tire_saturation" && effect_id != "friction_change" && effect_id != "load_transfer");
+    return WithEffects<Base>::kTyreEffects || effect_spec(effect_id).hook != EffectHook::kTyre;
   }
   CorrectedModelFile file(const EffectParams& e, const std::vector<std::string>& selected) const override {
     CorrectedModelFile f = file_;
@@ -95,16 +74,14 @@ std::unique_ptr<ModelFamily> model_family_of(const CorrectedModelFile& file) {
   CorrectedModelFile f = file;
   f.effects = {};
   f.selected.clear();
-  if (f.nominal_model == mppi::models::DoubleTrackModel::kName) return std::make_unique<WrappedFamily<DoubleTrack>>(DoubleTrack(f.double_track), f);
-  if (f.nominal_model == mppi::models::FullVehicleModel::kName) return std::make_unique<WrappedFamily<FullVehicle>>(FullVehicle(f.full_vehicle), f);
-  if (f.nominal_model == mppi::models::Kinematic::kName)
-    return std::make_unique<WrappedFamily<KinematicBicycle>>(KinematicBicycle(f.kinematic), f);
-  if (f.nominal_model == mppi::models::AutoRallyNetworkModel::kName)
-    return std::make_unique<WrappedFamily<AutoRallyNetwork>>(
-        AutoRallyNetwork::load(sim::network_file_or_default(f.network_npz)), f);
-  if (f.nominal_model != mppi::models::SingleTrackModel::kName)
+  std::unique_ptr<ModelFamily> family;
+  const bool known = visit_by_name(CorrectedNominalModels{}, f.nominal_model, [&]<class D>() {
+    using Base = typename D::Model;
+    family = std::make_unique<WrappedFamily<Base>>(corrected_nominal<D>(f, sim::network_file_or_default(f.network_npz)), f);
+  });
+  if (!known)
     throw Error("nominal model '" + f.nominal_model + "' cannot be diagnosed (valid: " + kCorrectedNominalModels + ")");
-  return std::make_unique<SingleTrackFamily>(f.nominal);
+  return family;
 }
 
 std::unique_ptr<ModelFamily> make_model_family(const std::string& model, const std::string& params_path) {

@@ -1,15 +1,14 @@
 #pragma once
 // The nominal model a diagnosis starts from, as a family of "nominal + effects" models: one
-// member per set of effect values. Single-track (CorrectedSingleTrack, every effect inside its
-// force balance); double-track, full-vehicle, kinematic and the AutoRally network
-// (WithEffects<...>, dynamics/with_effects.hpp; tyre effects only where there are tyres).
+// member per set of effect values: WithEffects<Model> (dynamics/with_effects.hpp) around any of
+// CorrectedNominalModels (tyre effects only where there are tyres).
 // The replay and the fits see a member through ReplayModel: one state vector, stepped one
 // sample at a time (offline work, so a virtual call per step is fine here).
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "dynamics/corrected_single_track.hpp"
+#include "dynamics/corrected_model.hpp"
 
 namespace mppi::diagnose {
 

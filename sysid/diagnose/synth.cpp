@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -124,19 +125,16 @@ sim::Recording drive_open_loop(M truth_model, std::uint64_t seed, double duratio
 
 sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t seed, double duration_s,
                                     const SensorNoise& noise, const std::string& nominal_model) {
-  if (nominal_model == mppi::models::DoubleTrackModel::kName)
-    return drive_open_loop(DoubleTrackWithEffects(DoubleTrack(), truth), seed, duration_s, noise);
-  if (nominal_model == mppi::models::FullVehicleModel::kName)
-    return drive_open_loop(FullVehicleWithEffects(FullVehicle(), truth), seed, duration_s, noise);
-  if (nominal_model == mppi::models::Kinematic::kName)
-    return drive_open_loop(KinematicWithEffects(KinematicBicycle(), truth), seed, duration_s, noise);
-  if (nominal_model == mppi::models::AutoRallyNetworkModel::kName)
-    return drive_open_loop(
-        AutoRallyNetworkWithEffects(AutoRallyNetwork::load(sim::network_file_or_default("")), truth), seed,
-        duration_s, noise);
-  if (nominal_model != mppi::models::SingleTrackModel::kName)
-    throw Error("synthesize_open_loop: unknown nominal model '" + nominal_model + "'");
-  return drive_open_loop(CorrectedSingleTrack(SingleTrackParams{}, truth), seed, duration_s, noise);
+  std::optional<sim::Recording> rec;
+  const CorrectedModelFile defaults;  // the library's default parameters of every nominal model
+  visit_by_name(CorrectedNominalModels{}, nominal_model, [&]<class D>() {
+    using M = WithEffects<typename D::Model>;
+    rec.emplace(drive_open_loop(M(corrected_nominal<D>(defaults, sim::network_file_or_default("")), truth), seed,
+                                duration_s, noise));
+  });
+  if (!rec) throw Error("synthesize_open_loop: unknown nominal model '" + nominal_model + "' (valid: " +
+                        kCorrectedNominalModels + ")");
+  return std::move(*rec);
 }
 
 std::vector<std::pair<double, double>> speed_schedule(std::uint64_t seed, double duration_s, double speed_min_mps,

@@ -1,6 +1,6 @@
 #pragma once
 // The concealed-effect generator: a truth plant = nominal single-track + hidden effects
-// (CorrectedSingleTrack), driven around a track in closed loop by MPPI that uses the NOMINAL
+// (WithEffects<SingleTrack>), driven around a track in closed loop by MPPI that uses the NOMINAL
 // model (sim::run_closed_loop), logged at 50 Hz with realistic sensor noise added. The
 // diagnosis tool later gets only the recording and the nominal model.
 #include <cstdint>
@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "dynamics/corrected_single_track.hpp"
+#include "dynamics/corrected_model.hpp"
 #include "dynamics/model_registry.hpp"
 #include "sim/recording.hpp"
 
@@ -62,8 +62,8 @@ int synthesize(const SynthOptions& o, const std::string& csv_path);
 // A fast open-loop variant for tests: the truth plant (500 Hz, no slew limits) driven on open
 // ground by random steering and throttle (held 0.1-0.5 s, speed kept in about 3-9 m/s), logged at
 // 50 Hz with sensor noise, in the recording format (metadata source "mppi-fit synth").
-// nominal_model: the truth's base, single-track (CorrectedSingleTrack), or double-track,
-// full-vehicle, kinematic, autorally-nn (WithEffects<...>), with the library's defaults.
+// nominal_model: the truth's base, single-track, double-track,
+// full-vehicle, kinematic, autorally-nn (WithEffects<Model>), with the library's defaults.
 sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t seed, double duration_s,
                                     const SensorNoise& noise = {}, const std::string& nominal_model = mppi::models::SingleTrackModel::kName);
 

@@ -8,7 +8,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "dynamics/corrected_single_track.hpp"
+#include "dynamics/corrected_model.hpp"
+#include "dynamics/with_effects.hpp"
 #include "dynamics/single_track.hpp"
 #include "mppi/error.hpp"
 #include "sysid/diagnose/data.hpp"
@@ -62,7 +63,7 @@ TEST_CASE("corrected model without effects steps exactly like the single-track m
 TEST_CASE("pure delay chain delays a step by about its delay", "[diagnose]") {
   EffectParams e;
   e.steer_delay_s = 0.1;
-  const CorrectedSingleTrack m({}, e);
+  const CorrectedSingleTrack m(SingleTrack(), e);
   float x[CorrectedSingleTrack::kNx] = {};
   // Time for the chain output to reach half of a unit step: the median of the Erlang(4)
   // distribution with mean 0.1 s is 0.0918 s (Gamma(4, 0.025 s) median).

@@ -10,7 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dynamics/corrected_single_track.hpp"
+#include "dynamics/corrected_model.hpp"
+#include "dynamics/with_effects.hpp"
 #include "sysid/diagnose/diagnose.hpp"
 #include "sysid/diagnose/synth.hpp"
 
