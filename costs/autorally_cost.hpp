@@ -1,6 +1,7 @@
 #pragma once
 // The AutoRally running cost (Goldfain et al., "AutoRally", IEEE CSM 2019, MPPI sidebar):
 //   q(x, t) = w . ( C_M(p_x, p_y), (v_x - v_x^d)^2, 0.9^t I, (v_y / v_x)^2 ),  w = (100, 4.25, 10000, 1.75)
+// a sum of terms declared in costs/autorally_cost_terms.hpp, weights as parameters.
 // C_M is the cost map at the body position; I is 1 when the car counts as crashed (cost-map
 // value at/above the boundary threshold, roll too large, or yaw rate too large), else 0.
 // Stateless per step: unlike upstream costs.cu the crash flag does not latch over a rollout.
@@ -13,6 +14,7 @@
 #include <vector>
 #include <utility>
 
+#include "costs/autorally_cost_terms.hpp"
 #include "costs/cost_map.hpp"
 #include "mppi/batch.hpp"
 #include "mppi/param_table.hpp"
@@ -83,18 +85,6 @@ inline std::vector<ParamField> param_table(AutoRallyCostParams& p) {
   };
 }
 
-// One evaluation split into its weighted terms (total = track + speed + crash + slip, except
-// that a NaN/inf state gives total = +inf).
-struct CostTerms {
-  float map_value = 0.f;  // C_M(p_x, p_y), unweighted
-  bool crashed = false;   // the indicator I
-  float track = 0.f;      // track_weight * C_M
-  float speed = 0.f;      // speed_weight * (v_x - v_x^d)^2
-  float crash = 0.f;      // crash_weight * discount^t * I
-  float slip = 0.f;       // slip_weight * v_y^2 / max(v_x^2, v_min^2)
-  float total = 0.f;
-};
-
 class AutoRallyCost {
  public:
   // Throws mppi::Error if map is null or params are invalid (message says which field).
@@ -136,6 +126,13 @@ class AutoRallyCost {
   const CostMap& map() const noexcept { return *map_; }
   const std::shared_ptr<const CostMap>& map_ptr() const noexcept { return map_; }
 
+  // The terms in the list's order, (t1 + t2) + t3 + ..., each also reported in c.
+  template <class... Term>
+  static float sum_of_terms(TypeList<Term...>, const AutoRallyCostParams& p, const CostState& state,
+                            CostTerms& c) noexcept {
+    return (... + (c.*(Term::kOut) = Term::value(p, state)));
+  }
+
   // crash_weight * crash_discount^t: the crash term's value at step t.
   float crash_cost_at(int t) const noexcept {
     return params_.crash_weight * std::pow(params_.crash_discount, static_cast<float>(t));
@@ -151,17 +148,13 @@ class AutoRallyCost {
     c.map_value = map.lookup(x_m, y_m);
     c.crashed = (c.map_value >= p.boundary_threshold) | (std::fabs(roll_rad) > p.max_roll_rad) |
                 (std::fabs(yaw_rate_radps) > p.max_yaw_rate_radps);
-    const float dv = vx_mps - p.target_speed_mps;
-    const float vmin = p.slip_min_speed_mps;
-    c.track = p.track_weight * c.map_value;
-    c.speed = p.speed_weight * dv * dv;
     // bool -> int -> float: GCC 12 does not vectorise a direct bool -> float conversion.
-    c.crash = crash_cost * static_cast<float>(static_cast<int>(c.crashed));
-    c.slip = p.slip_weight * (vy_mps * vy_mps) / std::max(vx_mps * vx_mps, vmin * vmin);
+    const CostState state{c.map_value, static_cast<float>(static_cast<int>(c.crashed)), vx_mps, vy_mps, crash_cost};
+    float sum = sum_of_terms(AutoRallyCostTerms{}, p, state, c);
     // 0 * (a + b + ...) is 0 for finite inputs and NaN if any is NaN or infinite: it carries
     // non-finite inputs that the clamped lookup and the comparisons would hide into the sum.
     const float poison = 0.f * (x_m + y_m + yaw_rate_radps + roll_rad);
-    const float sum = c.track + c.speed + c.crash + c.slip + poison;
+    sum += poison;
     // std::min(a, b) is (b < a) ? b : a, so a NaN sum yields +inf; a finite one itself.
     c.total = std::min(std::numeric_limits<float>::infinity(), sum);
     return c;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "costs/autorally_cost.hpp"
@@ -211,4 +212,32 @@ TEST_CASE("AutoRallyCostParams: defaults are the paper's and validation catches 
   bad = p;
   bad.track_weight = kNan;
   CHECK_THROWS_AS(mppi::AutoRallyCost(small_map(), bad), mppi::Error);
+}
+
+TEST_CASE("the cost is the sum of its declared terms, each a closed form of its weight", "[cost]") {
+  mppi::AutoRallyCostParams p;
+  p.target_speed_mps = 7.f;
+  const mppi::AutoRallyCost cost(small_map(), p);
+  const auto s = state(2.5f, 1.5f, 5.f, 0.8f, 0.2f, 0.f);  // map value 0.3, no crash
+  mppi::CostTerms c;
+  const float total = cost.evaluate(s.data(), 3, &c);
+  // Closed forms of the paper's four terms at this state.
+  CHECK(c.track == Approx(100.0 * 0.3));
+  CHECK(c.speed == Approx(4.25 * 4.0));
+  CHECK(c.crash == 0.f);
+  CHECK(c.slip == Approx(1.75 * 0.64 / 25.0));
+  // One term per CostTerms field, names unique, and the total adds exactly these.
+  std::vector<std::string> names;
+  float sum = 0.f;
+  mppi::for_each_type(mppi::AutoRallyCostTerms{}, [&]<class Term>() {
+    names.emplace_back(Term::kName);
+    sum += c.*(Term::kOut);
+  });
+  CHECK(names == std::vector<std::string>{"track", "speed", "crash", "slip"});
+  CHECK(total == Approx(sum).epsilon(1e-6));
+  // A term's weight is data: zero it and the total drops by exactly that term.
+  mppi::AutoRallyCost no_speed = cost;
+  std::string why;
+  REQUIRE(no_speed.set_param("speed_weight", 0.0, &why));
+  CHECK(no_speed.evaluate(s.data(), 3) == Approx(total - c.speed).epsilon(1e-6));
 }
