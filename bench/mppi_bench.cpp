@@ -4,6 +4,10 @@
 //   BM_MppiIteration/threads:N   one controller.step(x0): sampling + rollouts + weights + update
 //                                (AutoRally network, AutoRallyCost on the Gazebo cost map,
 //                                K = 1920, T = 100, 1 iteration)
+//   BM_MppiContention/threads:N/busy:B/schedule:S  the same step while B busy processes (started
+//                                and stopped by the benchmark) share the CPU; S: 0 work stealing
+//                                (oneTBB, the default), 1 OpenMP dynamic, 2 OpenMP static
+//   BM_StepLatency/threads:N/steps:M/schedule:S  p50, p99 and max of M step() wall times
 //   BM_BareLimit/threads:N       the network alone over the same K x T, hand-tuned (bare_limit.hpp)
 //   BM_NoiseSampling/threads:N   drawing the K x T x 2 clamped perturbed controls
 //   BM_NetworkRollout/threads:N  backend rollout, network + kinematics, cost = 0
@@ -17,14 +21,19 @@
 // double-precision reference, and exits 1 if it does not.
 #include <benchmark/benchmark.h>
 #include <omp.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "bare_limit.hpp"
@@ -137,6 +146,85 @@ void BM_MppiIteration(benchmark::State& state) {
   if (summary.status != mppi::StepStatus::kOk) state.SkipWithError(summary.reason);
 }
 
+// ---- 1b. the step under a shared CPU, and its latency distribution ------------------------
+// Busy processes that compete for the cores while a benchmark runs: started by the benchmark,
+// killed when it ends.
+class BusyProcesses {
+ public:
+  explicit BusyProcesses(int count) {
+    for (int i = 0; i < count; ++i) {
+      const pid_t pid = fork();
+      if (pid == 0) {
+        volatile std::uint64_t spin = 0;
+        for (;;) spin = spin + 1;  // until killed
+      }
+      if (pid > 0) pids_.push_back(pid);
+    }
+    if (count > 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));  // let them start
+  }
+  ~BusyProcesses() {
+    for (pid_t pid : pids_) kill(pid, SIGKILL);
+    for (pid_t pid : pids_) waitpid(pid, nullptr, 0);
+  }
+  BusyProcesses(const BusyProcesses&) = delete;
+  BusyProcesses& operator=(const BusyProcesses&) = delete;
+
+ private:
+  std::vector<pid_t> pids_;
+};
+
+// 0 work stealing (oneTBB, the default), 1 OpenMP dynamic, 2 OpenMP static
+mppi::ThreadSchedule schedule_arg(std::int64_t arg) {
+  return arg == 0 ? mppi::ThreadSchedule::kWorkStealing
+                  : arg == 1 ? mppi::ThreadSchedule::kDynamic : mppi::ThreadSchedule::kStatic;
+}
+
+// One controller.step(x0) while `busy` other processes spin on the machine.
+void BM_MppiContention(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  mppi::ControllerOptions o = options(threads);
+  o.schedule = schedule_arg(state.range(2));
+  mppi::Controller controller = mppi::make_cpu_controller(network(), make_cost(), o);
+  const std::vector<float> x0 = model_state(network(), start_state());
+  mppi::StepSummary summary;
+  for (int i = 0; i < 3; ++i) controller.step(x0, &summary);
+  const BusyProcesses busy(static_cast<int>(state.range(1)));
+  for (auto _ : state) {
+    auto u = controller.step(x0, &summary);
+    benchmark::DoNotOptimize(u.data());
+    benchmark::ClobberMemory();
+  }
+  set_rate_counters(state, threads);
+}
+
+// The distribution of step() wall times over many steps (quiet machine): p50, p99, max [ms].
+void BM_StepLatency(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  const int steps = static_cast<int>(state.range(1));
+  mppi::ControllerOptions o = options(threads);
+  o.schedule = schedule_arg(state.range(2));
+  mppi::Controller controller = mppi::make_cpu_controller(network(), make_cost(), o);
+  const std::vector<float> x0 = model_state(network(), start_state());
+  mppi::StepSummary summary;
+  for (int i = 0; i < 3; ++i) controller.step(x0, &summary);
+  std::vector<double> ms(static_cast<std::size_t>(steps));
+  for (auto _ : state) {
+    for (int i = 0; i < steps; ++i) {
+      const auto t0 = std::chrono::steady_clock::now();
+      auto u = controller.step(x0, &summary);
+      benchmark::DoNotOptimize(u.data());
+      ms[static_cast<std::size_t>(i)] =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    }
+  }
+  std::sort(ms.begin(), ms.end());
+  auto at = [&](double q) { return ms[static_cast<std::size_t>(q * (ms.size() - 1))]; };
+  state.counters["p50_ms"] = at(0.5);
+  state.counters["p99_ms"] = at(0.99);
+  state.counters["max_ms"] = ms.back();
+  state.counters["p99_over_p50"] = at(0.99) / at(0.5);
+}
+
 // ---- 2. the bare limit ---------------------------------------------------------------------
 const mppi::bench::MlpWeights& mlp_weights() {
   static const mppi::bench::MlpWeights w = mppi::bench::load_mlp_weights(data_path(kNetworkFile));
@@ -236,6 +324,18 @@ void thread_args(benchmark::internal::Benchmark* b) {
   b->ArgName("threads")->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 }
 BENCHMARK(BM_MppiIteration)->Apply(thread_args);
+// threads x busy processes x schedule (0 work stealing, 1 OpenMP dynamic, 2 OpenMP static)
+BENCHMARK(BM_MppiContention)
+    ->ArgNames({"threads", "busy", "schedule"})
+    ->ArgsProduct({{1, 2}, {0, 1, 2}, {0, 1, 2}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_StepLatency)
+    ->ArgNames({"threads", "steps", "schedule"})
+    ->ArgsProduct({{1, 2}, {10000}, {0, 1, 2}})
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BareLimit)->Apply(thread_args);
 BENCHMARK(BM_NoiseSampling)->Apply(thread_args);
 BENCHMARK(BM_NetworkRollout)->Apply(thread_args);

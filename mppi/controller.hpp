@@ -25,6 +25,7 @@
 #include "mppi/multiversion.hpp"
 #include "mppi/noise.hpp"
 #include "mppi/savitzky_golay.hpp"
+#include "mppi/thread_schedule.hpp"
 
 namespace mppi {
 
@@ -80,6 +81,17 @@ MPPI_MULTIVERSION inline void sample_chunk(const NoiseKey& key, std::uint32_t it
 }
 }  // namespace detail
 
+namespace detail {
+// sum_k w_k v_k in one fixed order. Not inlined: every schedule and thread count runs this same
+// code, so the sum (and the controls) do not depend on them.
+[[gnu::noinline]] inline float weighted_row(const float* w, const float* v, int k_count) noexcept {
+  float acc = 0.f;
+#pragma omp simd reduction(+ : acc)
+  for (int k = 0; k < k_count; ++k) acc += w[k] * v[k];
+  return acc;
+}
+}  // namespace detail
+
 class Controller {
  public:
   // Takes any backend; throws mppi::Error if the options are invalid for it.
@@ -94,7 +106,8 @@ class Controller {
     nu_ = s.num_controls;
     nx_ = s.num_states;
     padded_ = s.padded_samples;
-    threads_ = options_.num_threads > 0 ? options_.num_threads : omp_get_max_threads();
+    runner_ = std::make_unique<ParallelRunner>(options_.num_threads, options_.schedule);
+    threads_ = runner_->threads();
     nominal_.assign(static_cast<std::size_t>(options_.horizon) * nu_, 0.f);
     next_.assign(nominal_.size(), 0.f);
     controls_.assign(nominal_.size() * padded_, 0.f);
@@ -179,12 +192,12 @@ class Controller {
     const NoiseKey key{options_.seed};
     const int chunks = padded_ / kChunk;
     const float gamma = options_.gamma;
-#pragma omp parallel for schedule(static) num_threads(threads_)
-    for (int chunk = 0; chunk < chunks; ++chunk)
+    runner_->run(chunks, 1, [&](int chunk, int) {
       detail::sample_chunk(key, iteration, chunk * kChunk, options_.num_samples, padded_,
                            options_.horizon, nu_, nominal_.data(), options_.noise_std.data(),
                            options_.control_min.data(), options_.control_max.data(), gamma,
                            controls_.data(), control_costs_.data());
+    });
   }
 
   // Exponential weights and the weighted average. False if no sample has a finite cost.
@@ -241,14 +254,9 @@ class Controller {
     const float* v = controls_.data();
     const float* w = weights_.data();
     const int padded = padded_;
-#pragma omp parallel for schedule(static) num_threads(threads_)
-    for (int row = 0; row < rows; ++row) {
-      const float* vr = v + static_cast<std::size_t>(row) * padded;
-      float acc = 0.f;
-#pragma omp simd reduction(+ : acc)
-      for (int k = 0; k < k_count; ++k) acc += w[k] * vr[k];
-      next[row] = acc;
-    }
+    runner_->run(rows, 8, [&](int row, int) {
+      next[row] = detail::weighted_row(w, v + static_cast<std::size_t>(row) * padded, k_count);
+    });
   }
 
   // The whole iteration on the backend (device noise, rollouts, weights, weighted sum); the
@@ -317,6 +325,7 @@ class Controller {
   std::unique_ptr<Backend> backend_;
   ControllerOptions options_;
   int nu_ = 0, nx_ = 0, padded_ = 0, threads_ = 1;
+  std::unique_ptr<ParallelRunner> runner_;  // the CPU threads of sampling and the weighted sum
   std::uint64_t step_index_ = 0;
   std::vector<float> nominal_;        // T x nu
   std::vector<float> next_;           // T x nu, the unsmoothed update
@@ -336,7 +345,7 @@ Controller make_cpu_controller(D model, C cost, const ControllerOptions& options
   if (!options.is_valid(D::kNu, &why)) throw Error("ControllerOptions: " + why);
   auto backend = std::make_unique<CpuBackend<D, C>>(std::move(model), std::move(cost),
                                                     options.num_samples, options.horizon,
-                                                    options.dt_s, options.num_threads);
+                                                    options.dt_s, options.num_threads, options.schedule);
   return Controller(std::move(backend), options);
 }
 

@@ -8,6 +8,13 @@
 
 namespace mppi {
 
+// How the CPU threads share an iteration's chunks of samples (mppi/thread_schedule.hpp).
+// kWorkStealing (oneTBB): idle threads steal chunks and sleep after a short spin, so a thread
+// that shares its core with another process takes fewer chunks and waiting threads leave the
+// cores to the working ones (measured: docs/BENCHMARKS.md, contention). kDynamic / kStatic:
+// OpenMP with dynamic or static chunks. Results do not depend on it.
+enum class ThreadSchedule { kWorkStealing, kDynamic, kStatic };
+
 struct ControllerOptions {
   int num_samples = 1920;          // K: sampled control sequences per iteration
   int horizon = 100;               // T: time steps per sequence
@@ -23,6 +30,7 @@ struct ControllerOptions {
   int smoothing_order = 2;         // Savitzky-Golay polynomial order (< window)
   std::uint64_t seed = 1;          // noise seed (draws depend on seed, step, sample, t, channel)
   int num_threads = 0;             // CPU threads; 0 = OpenMP default
+  ThreadSchedule schedule = ThreadSchedule::kWorkStealing;  // how the CPU threads share the work
 
   // Checks against a model with `num_controls` channels; on failure writes why.
   bool is_valid(int num_controls, std::string* why) const {

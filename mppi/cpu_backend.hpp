@@ -1,6 +1,7 @@
 #pragma once
 // CPU backend: OpenMP over chunks of kChunk samples, each chunk rolled out with the model and
 // cost inlined over SoA lanes. Scratch memory per thread is allocated once, at construction.
+// The chunks go to the threads as the schedule says (mppi/thread_schedule.hpp).
 #include <omp.h>
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include "mppi/concepts.hpp"
 #include "mppi/error.hpp"
 #include "mppi/multiversion.hpp"
+#include "mppi/thread_schedule.hpp"
 
 namespace mppi {
 
@@ -46,11 +48,12 @@ inline int padded_sample_count(int num_samples) {
 template <Dynamics D, StageCost<D> C>
 class CpuBackend final : public Backend {
  public:
-  CpuBackend(D model, C cost, int num_samples, int horizon, float dt_s, int num_threads)
-      : model_(std::move(model)), cost_(std::move(cost)), dt_s_(dt_s) {
+  CpuBackend(D model, C cost, int num_samples, int horizon, float dt_s, int num_threads,
+             ThreadSchedule schedule = ThreadSchedule::kDynamic)
+      : model_(std::move(model)), cost_(std::move(cost)), dt_s_(dt_s), runner_(num_threads, schedule) {
     if (num_samples < 1 || horizon < 1) throw Error("CpuBackend: need num_samples, horizon >= 1");
     shape_ = {num_samples, padded_sample_count(num_samples), horizon, D::kNx, D::kNu};
-    threads_ = num_threads > 0 ? num_threads : omp_get_max_threads();
+    threads_ = runner_.threads();
     work_floats_ = static_cast<std::size_t>((D::kNx + D::kNu) * kChunk) +
                    model_.scratch_floats(kChunk);
     // Round each thread's slice to a cache line (16 floats) so threads never share one.
@@ -80,18 +83,19 @@ class CpuBackend final : public Backend {
     const float* x0p = x0.data();
     const float* vp = controls.data();
     float* sp = costs.data();
-#pragma omp parallel for schedule(static) num_threads(threads_)
-    for (int chunk = 0; chunk < chunks; ++chunk) {
-      float* work = work_.data() + work_floats_ * static_cast<std::size_t>(omp_get_thread_num());
+    float* work = work_.data();
+    const std::size_t work_floats = work_floats_;
+    runner_.run(chunks, 1, [&](int chunk, int slot) {
       detail::rollout_chunk(model_, cost_, x0p, vp, padded, shape_.horizon, dt_s_, chunk * kChunk,
-                            work, sp + chunk * kChunk);
-    }
+                            work + work_floats * static_cast<std::size_t>(slot), sp + chunk * kChunk);
+    });
   }
 
  private:
   D model_;
   C cost_;
   float dt_s_;
+  ParallelRunner runner_;
   RolloutShape shape_;
   int threads_ = 1;
   std::size_t work_floats_ = 0;

@@ -157,13 +157,16 @@ TEST_CASE("the update law equals a naive re-computation from the samples", "[cor
   CHECK(summary.min_cost == Approx(s_min).epsilon(1e-4));
 }
 
-TEST_CASE("controls are identical for 1 and 2 threads", "[core][mppi]") {
+TEST_CASE("controls are identical for 1 and 2 threads and every schedule", "[core][mppi]") {
   auto options = linear_options();
   options.num_samples = 1000;
   options.iterations = 3;
   std::vector<std::vector<float>> runs;
-  for (int threads : {1, 2}) {
+  for (const auto& [threads, schedule] :
+       {std::pair{1, mppi::ThreadSchedule::kWorkStealing}, std::pair{2, mppi::ThreadSchedule::kWorkStealing},
+        std::pair{2, mppi::ThreadSchedule::kDynamic}, std::pair{2, mppi::ThreadSchedule::kStatic}}) {
     options.num_threads = threads;
+    options.schedule = schedule;
     auto controller = mppi::make_cpu_controller(DoubleIntegrator{}, QuadraticCost{}, options);
     std::vector<float> out;
     float x[2] = {1.f, 0.3f};
@@ -175,7 +178,8 @@ TEST_CASE("controls are identical for 1 and 2 threads", "[core][mppi]") {
     }
     runs.push_back(out);
   }
-  for (std::size_t i = 0; i < runs[0].size(); ++i) REQUIRE(runs[0][i] == runs[1][i]);
+  for (std::size_t r = 1; r < runs.size(); ++r)
+    for (std::size_t i = 0; i < runs[0].size(); ++i) REQUIRE(runs[0][i] == runs[r][i]);
   // and a different seed gives different controls (the test could fail)
   options.seed = 12;
   auto other = mppi::make_cpu_controller(DoubleIntegrator{}, QuadraticCost{}, options);
