@@ -8,9 +8,16 @@
 #include "mppi/controller.hpp"
 #include "tests/mppi/linear_system.hpp"
 
+#include "tests/mppi/allocation_counter.hpp"
+
+namespace mppi::test {
+std::atomic<bool> counting_allocations{false};
+std::atomic<long> allocations_counted{0};
+}  // namespace mppi::test
+
 namespace {
-std::atomic<bool> counting{false};
-std::atomic<long> allocations{0};
+std::atomic<bool>& counting = mppi::test::counting_allocations;
+std::atomic<long>& allocations = mppi::test::allocations_counted;
 }  // namespace
 
 void* operator new(std::size_t size) {
