@@ -30,7 +30,8 @@ Reject PacketFilter::handle(std::span<const std::uint8_t> bytes, std::size_t dat
   ++counters_.received;
   const Message m = decode(bytes, datagram_size);
   if (m.reason != Reject::kNone) return count(m.reason);
-  if (m.type == MessageType::kState) return count(Reject::kBadType);  // vehicle -> stack only
+  if (m.type == MessageType::kState || m.type == MessageType::kParameter)
+    return count(Reject::kBadType);  // vehicle -> stack, operator -> stack only
   int index = -1;
   if (m.type == MessageType::kCommand) {
     index = arbiter.priorities().index_of(m.sender);
@@ -204,6 +205,52 @@ std::optional<StateMessage> UdpChassisClient::receive_state(double timeout_s) {
     const double left = std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
     if (left <= 0 || !socket_.wait_readable(left)) return std::nullopt;
   }
+}
+
+UdpParameterListener::UdpParameterListener(const std::string& bind_address, int port, std::size_t max_senders)
+    : socket_(bind_address, port), max_senders_(max_senders) {}
+
+std::optional<ParameterUpdate> UdpParameterListener::receive(double timeout_s) {
+  const auto deadline = std::chrono::steady_clock::now() + seconds(timeout_s);
+  std::array<std::uint8_t, kMaxMessageSize + 1> buffer;
+  while (true) {
+    sockaddr_in from{};
+    const long n = socket_.receive(buffer, &from);
+    if (n >= 0) {
+      const std::size_t kept = std::min<std::size_t>(static_cast<std::size_t>(n), buffer.size());
+      const Message m = decode(std::span<const std::uint8_t>(buffer.data(), kept), static_cast<std::size_t>(n));
+      if (m.reason != Reject::kNone || m.type != MessageType::kParameter) {
+        ++rejected_;
+        continue;
+      }
+      std::pair<std::string, std::uint64_t>* entry = nullptr;
+      for (auto& e : last_sequence_)
+        if (e.first == m.sender) entry = &e;
+      if (entry ? m.sequence <= entry->second : last_sequence_.size() >= max_senders_) {
+        ++rejected_;  // replayed, or too many senders
+        continue;
+      }
+      if (entry) entry->second = m.sequence;
+      else last_sequence_.emplace_back(m.sender, m.sequence);
+      return ParameterUpdate{m.sender, m.parameter_name, m.parameter_value};
+    }
+    const double left = std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
+    if (left <= 0 || !socket_.wait_readable(left)) return std::nullopt;
+  }
+}
+
+UdpParameterSender::UdpParameterSender(std::string sender, const std::string& host, int port)
+    : sender_(std::move(sender)),
+      socket_(host == "127.0.0.1" ? "127.0.0.1" : "0.0.0.0", 0),
+      to_(make_address(host, port)),
+      sequence_(static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
+                                               std::chrono::system_clock::now().time_since_epoch())
+                                               .count())) {
+  encode_runstop(sender_, 0, false);  // validates the sender name (throws mppi::Error)
+}
+
+void UdpParameterSender::send(std::string_view name, double value) {
+  socket_.send_to(encode_parameter(sender_, sequence_++, name, value), to_);
 }
 
 }  // namespace mppi::chassis::udp

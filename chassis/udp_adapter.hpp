@@ -12,6 +12,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <netinet/in.h>
@@ -118,6 +119,47 @@ class UdpChassisClient {
   std::uint64_t last_state_sequence_ = 0;
   bool have_state_ = false;
   long rejected_ = 0;
+};
+
+// A parameter change for the stack (e.g. the controller's target speed), as received.
+struct ParameterUpdate {
+  std::string sender;
+  std::string name;
+  double value = 0.0;
+};
+
+// The stack end of parameter messages (type 4): an operator station or script changes a cost
+// parameter of the running controller. Checks like the chassis server's: well-formed, a
+// parameter message, sequence rising per sender; the value itself is checked by whoever
+// applies it (Controller::set_cost_param names the key and range it refuses).
+class UdpParameterListener {
+ public:
+  UdpParameterListener(const std::string& bind_address = "127.0.0.1", int port = kDefaultParameterPort,
+                       std::size_t max_senders = 64);
+  int port() const { return socket_.port(); }
+  // The next accepted parameter message within timeout_s, if any.
+  std::optional<ParameterUpdate> receive(double timeout_s);
+  long rejected() const { return rejected_; }
+
+ private:
+  Socket socket_;
+  std::size_t max_senders_;
+  std::vector<std::pair<std::string, std::uint64_t>> last_sequence_;
+  long rejected_ = 0;
+};
+
+// Sends parameter messages to a stack's UdpParameterListener. The first sequence number is the
+// wall clock in microseconds (a restarted sender continues above its previous numbers).
+class UdpParameterSender {
+ public:
+  UdpParameterSender(std::string sender, const std::string& host = "127.0.0.1", int port = kDefaultParameterPort);
+  void send(std::string_view name, double value);
+
+ private:
+  std::string sender_;
+  Socket socket_;
+  sockaddr_in to_{};
+  std::uint64_t sequence_;
 };
 
 }  // namespace mppi::chassis::udp

@@ -112,6 +112,7 @@ const char* to_string(Reject r) {
     case Reject::kInvalidCommand: return "invalid command values";
     case Reject::kTooManySenders: return "too many senders";
     case Reject::kRunstopRejected: return "runstop source rejected";
+    case Reject::kBadParameterName: return "bad parameter name";
   }
   return "unknown reason";
 }
@@ -157,6 +158,20 @@ std::array<std::uint8_t, kStateSize> encode_state(std::string_view sender, std::
   return m;
 }
 
+std::array<std::uint8_t, kParameterSize> encode_parameter(std::string_view sender, std::uint64_t sequence,
+                                                          std::string_view name, double value) {
+  if (name.empty() || name.size() >= kParameterNameSize)
+    throw Error("udp: parameter name must have 1-31 characters, got '" + std::string(name) + "'");
+  for (char c : name)
+    if (!printable(c)) throw Error("udp: parameter name must be printable ASCII without spaces");
+  std::array<std::uint8_t, kParameterSize> m{};
+  put_header(m.data(), MessageType::kParameter, kParameterSize, sender, sequence);
+  std::memcpy(m.data() + 32, name.data(), name.size());
+  put_f64(m.data() + 32 + kParameterNameSize, value);
+  seal(m);
+  return m;
+}
+
 Message decode(std::span<const std::uint8_t> bytes, std::size_t datagram_size) {
   Message m;
   auto reject = [&](Reject r) {
@@ -176,6 +191,7 @@ Message decode(std::span<const std::uint8_t> bytes, std::size_t datagram_size) {
     case 1: expected = kCommandSize; break;
     case 2: expected = kRunstopSize; break;
     case 3: expected = kStateSize; break;
+    case 4: expected = kParameterSize; break;
     default: return reject(Reject::kBadType);
   }
   if (declared != expected) return reject(Reject::kLengthMismatch);
@@ -200,6 +216,16 @@ Message decode(std::span<const std::uint8_t> bytes, std::size_t datagram_size) {
     if (b[1] || b[2] || b[3]) return reject(Reject::kReservedNotZero);
     if (b[0] > 1) return reject(Reject::kBadRunstopValue);
     m.motion_enabled = b[0] == 1;
+  } else if (m.type == MessageType::kParameter) {
+    std::size_t n = 0;
+    while (n < kParameterNameSize && b[n] != 0) ++n;
+    if (n == 0 || n == kParameterNameSize) return reject(Reject::kBadParameterName);
+    for (std::size_t i = 0; i < n; ++i)
+      if (!printable(static_cast<char>(b[i]))) return reject(Reject::kBadParameterName);
+    for (std::size_t i = n; i < kParameterNameSize; ++i)
+      if (b[i] != 0) return reject(Reject::kBadParameterName);
+    std::memcpy(m.parameter_name, b, n);
+    m.parameter_value = get_f64(b + kParameterNameSize);
   } else {
     if (b[55]) return reject(Reject::kReservedNotZero);
     m.state.time_s = get_f64(b);

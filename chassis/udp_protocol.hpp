@@ -11,6 +11,8 @@
 //            yaw_rate, roll, f32[3] applied steering, throttle, front_brake, u16[3] pulse widths
 //            [us] steering, throttle, front_brake, u8 flags (1 motion enabled, 2 watchdog
 //            tripped), u8 zero
+//   parameter (type 4, 76 bytes, operator -> stack): char[32] name (1-31 printable ASCII, NUL-
+//            padded; a cost parameter key, e.g. target_speed_mps), f64 value
 //   trailer: u32 CRC-32 (IEEE 802.3, as zlib's crc32) of every byte before it.
 // The sequence number must increase strictly per sender name (across message types); a
 // datagram whose sequence is not above the last accepted one from that sender is a replay.
@@ -32,10 +34,13 @@ inline constexpr std::size_t kSenderSize = 16;  // including the NUL padding: na
 inline constexpr std::size_t kCommandSize = 52;
 inline constexpr std::size_t kRunstopSize = 40;
 inline constexpr std::size_t kStateSize = 92;
+inline constexpr std::size_t kParameterSize = 76;
+inline constexpr std::size_t kParameterNameSize = 32;  // including the NUL padding: names <= 31 chars
 inline constexpr std::size_t kMaxMessageSize = kStateSize;
 inline constexpr int kDefaultPort = 47800;
+inline constexpr int kDefaultParameterPort = 47801;  // the stack's port for parameter messages
 
-enum class MessageType : std::uint8_t { kCommand = 1, kRunstop = 2, kState = 3 };
+enum class MessageType : std::uint8_t { kCommand = 1, kRunstop = 2, kState = 3, kParameter = 4 };
 
 // Why a datagram was rejected (counted per reason by the server).
 enum class Reject : std::uint8_t {
@@ -55,8 +60,9 @@ enum class Reject : std::uint8_t {
   kInvalidCommand,   // NaN, out of range, negative front brake, bad actuator mask
   kTooManySenders,   // the sender table (replay state) is full
   kRunstopRejected,  // the arbiter refused the runstop source (too many sources)
+  kBadParameterName, // empty, not NUL-padded, or not printable ASCII
 };
-inline constexpr int kRejectCount = 16;
+inline constexpr int kRejectCount = 17;
 const char* to_string(Reject reason);
 
 struct StateMessage {
@@ -77,6 +83,8 @@ struct Message {
   Command command;                       // type kCommand (not validated here)
   bool motion_enabled = false;           // type kRunstop
   StateMessage state;                    // type kState
+  char parameter_name[kParameterNameSize + 1] = {};  // type kParameter, NUL-terminated
+  double parameter_value = 0.0;          // type kParameter (not validated here)
 };
 
 // CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320, init and final xor 0xFFFFFFFF).
@@ -89,6 +97,9 @@ std::array<std::uint8_t, kRunstopSize> encode_runstop(std::string_view sender, s
                                                       bool motion_enabled);
 std::array<std::uint8_t, kStateSize> encode_state(std::string_view sender, std::uint64_t sequence,
                                                   const StateMessage& state);
+
+std::array<std::uint8_t, kParameterSize> encode_parameter(std::string_view sender, std::uint64_t sequence,
+                                                          std::string_view name, double value);
 
 // Checks and decodes one datagram. `datagram_size` is its size on the wire (may exceed
 // bytes.size() when the receive buffer truncated it). Does not check replay or content.

@@ -9,8 +9,10 @@
 #include <cstdlib>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "chassis/control_loop.hpp"
 #include "chassis/udp_adapter.hpp"
@@ -42,6 +44,7 @@ constexpr const char* kUsage = R"(usage: mppi-udp-drive [options]
   --threads N          CPU threads, 0 = all                     (0)
   --seed N             noise seed                               (1)
   --duration S         stop after S seconds; 0 = until Ctrl-C   (30)
+  --param-port N       UDP port for parameter messages, 0 = off (47801)
 )";
 
 std::atomic<bool> g_stop{false};
@@ -65,7 +68,7 @@ int main(int argc, char** argv) {
   using namespace mppi::chassis;
   std::string host = "127.0.0.1", name = "mppi", runstop_name = "OCS", model = models::AutoRallyNetworkModel::kName,
               track_name = "gazebo";
-  int port = udp::kDefaultPort;
+  int port = udp::kDefaultPort, param_port = udp::kDefaultParameterPort;
   double speed = 6.0, duration_s = 30.0;
   ControlLoopSettings loop_settings;
   ControllerOptions options;
@@ -91,6 +94,7 @@ int main(int argc, char** argv) {
     else if (flag == "--threads") options.num_threads = static_cast<int>(number(flag, value()));
     else if (flag == "--seed") options.seed = static_cast<std::uint64_t>(number(flag, value()));
     else if (flag == "--duration") duration_s = number(flag, value());
+    else if (flag == "--param-port") param_port = static_cast<int>(number(flag, value()));
     else usage_error("unknown option " + flag);
   }
   try {
@@ -124,6 +128,22 @@ int main(int argc, char** argv) {
         if (auto s = commands.receive_state(0.05)) latest.put(*s);
       }
     });
+    // Parameter messages: a receiver thread queues them; the loop applies them between steps
+    // (it only tries the lock, so it never waits for the receiver).
+    std::mutex updates_mutex;
+    std::vector<udp::ParameterUpdate> updates, applying;
+    updates.reserve(64);
+    applying.reserve(64);
+    std::unique_ptr<udp::UdpParameterListener> params;
+    if (param_port > 0) params = std::make_unique<udp::UdpParameterListener>("127.0.0.1", param_port);
+    std::thread param_receiver([&] {
+      while (params && !stop_rx) {
+        if (auto u = params->receive(0.05)) {
+          const std::lock_guard<std::mutex> lock(updates_mutex);
+          if (updates.size() < 64) updates.push_back(std::move(*u));
+        }
+      }
+    });
     std::uint64_t seen = 0;
     SteadyClock clock;
     udp::StateMessage state_msg;
@@ -145,6 +165,18 @@ int main(int argc, char** argv) {
           return true;
         },
         [&](std::span<const float> x) {
+          if (std::unique_lock<std::mutex> lock(updates_mutex, std::try_to_lock); lock && !updates.empty()) {
+            applying.swap(updates);
+            lock.unlock();
+            for (const udp::ParameterUpdate& p : applying) {
+              std::string why;
+              if (controller->set_cost_param(p.name, p.value, &why))
+                std::fprintf(stderr, "mppi-udp-drive: %s = %g (from %s)\n", p.name.c_str(), p.value, p.sender.c_str());
+              else
+                std::fprintf(stderr, "mppi-udp-drive: parameter from %s refused: %s\n", p.sender.c_str(), why.c_str());
+            }
+            applying.clear();
+          }
           const auto u = controller->step(x);
           return Command{u[control::kSteer], u[control::kThrottle], 0.f, actuator::kAll};
         },
@@ -168,6 +200,7 @@ int main(int argc, char** argv) {
     runstop.send_runstop(false);  // leave the car stopped
     stop_rx = true;
     receiver.join();
+    param_receiver.join();
     std::printf("control loop: %s\n", loop.stats().to_string().c_str());
     std::printf("ticks without state: %ld\n", loop.ticks_without_state());
     std::printf("laps %d", laps.laps_completed());

@@ -5,6 +5,11 @@ library: it allows motion as runstop source 'OCS', sends a constant command as c
 
     build/bin/mppi-udp-bridge &          # the vehicle end (simulated car)
     python3 chassis/examples/udp_client.py --steering 0.3 --throttle 0.2 --seconds 3
+
+With --set NAME=VALUE it instead sends one parameter message to a running stack (mppi-udp-drive
+listens on --param-port, 47801 by default), e.g. a new target speed:
+
+    python3 chassis/examples/udp_client.py --set target_speed_mps=8
 """
 import argparse
 import socket
@@ -13,11 +18,12 @@ import time
 import zlib
 
 MAGIC, VERSION = b"MPCH", 1
-COMMAND, RUNSTOP, STATE = 1, 2, 3
+COMMAND, RUNSTOP, STATE, PARAMETER = 1, 2, 3, 4
 HEADER = struct.Struct("<4sBBHQ16s")            # magic, version, type, length, sequence, sender
 COMMAND_BODY = struct.Struct("<fffB3x")          # steering, throttle, front_brake, actuators
 RUNSTOP_BODY = struct.Struct("<B3x")             # motion_enabled
 STATE_BODY = struct.Struct("<d7f3f3HBx")         # time, state[7], applied[3], pulses[3], flags
+PARAMETER_BODY = struct.Struct("<32sd")          # name (NUL-padded), value
 
 
 def message(kind, sender, sequence, body):
@@ -46,7 +52,15 @@ def main():
     p.add_argument("--steering", type=float, default=0.0)
     p.add_argument("--throttle", type=float, default=0.2)
     p.add_argument("--seconds", type=float, default=3.0)
+    p.add_argument("--set", metavar="NAME=VALUE", help="send one parameter message to the stack and exit")
+    p.add_argument("--param-port", type=int, default=47801)
     a = p.parse_args()
+    if a.set:
+        name, _, value = a.set.partition("=")
+        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        body = PARAMETER_BODY.pack(name.encode("ascii"), float(value))
+        sock.sendto(message(PARAMETER, "OCS", int(time.time() * 1e6), body), (a.host, a.param_port))
+        return
     chassis = (a.host, a.port)
     sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     sock.settimeout(0.005)

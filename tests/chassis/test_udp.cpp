@@ -224,3 +224,61 @@ TEST_CASE("UDP loopback round trip through real sockets", "[chassis][udp]") {
   REQUIRE(other.has_value());
   CHECK(other->state[0] == 3.f);
 }
+
+TEST_CASE("parameter messages: documented layout, malformed names refused, never accepted by the chassis",
+          "[chassis][udp]") {
+  const auto m = encode_parameter("ocs", 7, "target_speed_mps", 8.5);
+  CHECK(m.size() == 76);
+  CHECK(m[5] == 4);
+  CHECK((m[6] | (m[7] << 8)) == 76);
+  CHECK(std::memcmp(m.data() + 32, "target_speed_mps", 16) == 0);
+  for (int i = 32 + 16; i < 64; ++i) CHECK(m[static_cast<std::size_t>(i)] == 0);
+  double value = 0;
+  std::memcpy(&value, m.data() + 64, 8);  // little-endian host (x86-64, aarch64)
+  CHECK(value == 8.5);
+  const Message d = decode(m, m.size());
+  REQUIRE(d.reason == Reject::kNone);
+  CHECK(d.type == MessageType::kParameter);
+  CHECK(std::string(d.parameter_name) == "target_speed_mps");
+  CHECK(d.parameter_value == 8.5);
+  // A name with a space, one not NUL-padded, an empty one.
+  Bytes spaced = vec(m);
+  spaced[32 + 6] = ' ';
+  reseal(spaced);
+  CHECK(decode(spaced, spaced.size()).reason == Reject::kBadParameterName);
+  Bytes unpadded = vec(m);
+  unpadded[32 + 20] = 'x';
+  reseal(unpadded);
+  CHECK(decode(unpadded, unpadded.size()).reason == Reject::kBadParameterName);
+  Bytes empty = vec(m);
+  std::memset(empty.data() + 32, 0, 32);
+  reseal(empty);
+  CHECK(decode(empty, empty.size()).reason == Reject::kBadParameterName);
+  CHECK_THROWS(encode_parameter("ocs", 1, "", 1.0));
+  CHECK_THROWS(encode_parameter("ocs", 1, std::string(32, 'a'), 1.0));
+  // The chassis refuses it as a message it does not take: it cannot move the car.
+  Arbiter arbiter(Priorities({{"mppi", 1}}));
+  PacketFilter filter;
+  CHECK(filter.handle(m, m.size(), arbiter, Time{0}) == Reject::kBadType);
+}
+
+TEST_CASE("parameter messages reach the stack through real sockets, replays refused", "[chassis][udp]") {
+  UdpParameterListener listener("127.0.0.1", 0);
+  UdpParameterSender sender("ocs", "127.0.0.1", listener.port());
+  sender.send("target_speed_mps", 9.0);
+  sender.send("speed_weight", 3.5);
+  auto a = listener.receive(1.0);
+  auto b = listener.receive(1.0);
+  REQUIRE(a);
+  REQUIRE(b);
+  CHECK(a->sender == "ocs");
+  CHECK(a->name == "target_speed_mps");
+  CHECK(a->value == 9.0);
+  CHECK(b->name == "speed_weight");
+  // The same datagram again is a replay; a command is not a parameter message.
+  UdpChassisClient raw("ocs", "127.0.0.1", listener.port(), 1);
+  raw.send_raw(encode_parameter("ocs", 1, "target_speed_mps", 1.0));  // sequence 1 is far below
+  raw.send_raw(encode_command("mppi", 5, Command{}));
+  CHECK_FALSE(listener.receive(0.3));
+  CHECK(listener.rejected() == 2);
+}
