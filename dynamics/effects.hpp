@@ -15,14 +15,23 @@
 //                                         approximation any integrator can step)
 //             steer_lag, throttle_lag     first-order actuators, time constant tau
 //             motor_voltage_sag           throttle u -> u - k max(u, 0)^2 (battery sag)
-//   tyre:     tire_saturation             Magic Formula peak D -> k D, B -> s B / k
+//             throttle_gain               throttle u -> g u (motor / ESC gain)
+//             steer_cubic                 steer s -> s + k s^3 (nonlinear steering linkage)
+//             steer_asymmetry             steer s -> (1 + a) s left, (1 - a) s right
+//             steer_rate_limit,           the applied command needs at least T seconds per
+//             throttle_rate_limit         unit of change (servo speed, ESC ramp): |du/dt| <= 1/T
+//             steer_backlash              play of width b between servo and wheels
+//   chassis:  tire_saturation             Magic Formula peak D -> k D, B -> s B / k
 //             friction_change             grip (D, Sv) x g from time t_change on
 //             load_transfer               CG height h -> h + dh (pitch load transfer)
+//             payload                     mass x m, yaw inertia x j
+//             motor_speed                 no-load speed x v (the motor's torque-speed line)
 //   force:    aero_drag                   extra force -c vx |vx|
 //             rolling_resistance          extra force -(F0 tanh(vx / 0.5) + b vx)
 //             road_grade                  a tilted plane z = gx x + gy y: -m g grad z
 // Every effect is off at its default value.
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -51,6 +60,15 @@ struct EffectParams {
   double voltage_sag = 0.0;          // [-] k in u - k max(u,0)^2
   double grade_x = 0.0;              // [-] slope dz/dx of the ground plane
   double grade_y = 0.0;              // [-] slope dz/dy of the ground plane
+  double throttle_gain = 1.0;        // [-] g in u -> g u
+  double steer_cubic = 0.0;          // [-] k in s -> s + k s^3
+  double steer_asymmetry = 0.0;      // [-] a: left (s > 0) x (1 + a), right x (1 - a)
+  double steer_slew_s = 0.0;         // [s] time per unit of applied steer: |ds/dt| <= 1/T (0 = none)
+  double throttle_slew_s = 0.0;      // [s] time per unit of applied throttle (0 = none)
+  double steer_backlash = 0.0;       // [-] width of the play (normalised steer)
+  double mass_scale = 1.0;           // [-] payload: mass x m
+  double yaw_inertia_scale = 1.0;    // [-] payload: yaw inertia x j
+  double motor_speed_scale = 1.0;    // [-] no-load speed x v
 
   bool is_valid(std::string* why) const;
 };
@@ -58,7 +76,7 @@ struct EffectParams {
 // Where an effect enters the physics of WithEffects<Model>.
 enum class EffectHook {
   kActuator,  // transforms the command before the model sees it
-  kTyre,      // changes the model's tyre / chassis parameters (models with a single-track core)
+  kChassis,   // changes the model's tyre / chassis parameters (models with a single-track core)
   kForce,     // adds a force along the body axes (inside the force balance where the model
               // offers it, else after the model's step)
 };
@@ -108,19 +126,39 @@ inline const std::vector<EffectSpec>& effect_table() {
        {{"steer_gain", &E::steer_gain, "1", kAny, 0.3, 2.0, 0.1}}, {0.7, 1.0, 1.3}, false},
       {"throttle_offset", "throttle bias / motor dead band", H::kActuator,
        {{"throttle_offset", &E::throttle_offset, "1 (normalised throttle)", kAny, -0.4, 0.4, 0.02}}, {}, false},
-      {"tire_saturation", "tyre friction limit (Pacejka peak D x k) and cornering stiffness (x s)", H::kTyre,
+      {"tire_saturation", "tyre friction limit (Pacejka peak D x k) and cornering stiffness (x s)", H::kChassis,
        {{"tyre_peak_scale", &E::tyre_peak_scale, "1", kScale, 0.3, 3.0, 0.1},
         {"tyre_stiffness_scale", &E::tyre_stiffness_scale, "1", kScale, 0.2, 5.0, 0.1}}, {0.6, 1.0, 1.4}, false},
-      {"friction_change", "grip (whole friction curve) x g from time t_change on", H::kTyre,
+      {"friction_change", "grip (whole friction curve) x g from time t_change on", H::kChassis,
        {{"grip_change_time_s", &E::grip_change_time_s, "s", kAny, 0.0, 1e9, 1.0},
         {"grip_scale", &E::grip_scale, "1", kScale, 0.3, 3.0, 0.1}}, {}, true},
-      {"load_transfer", "pitch load transfer: CG height h + dh", H::kTyre,
+      {"load_transfer", "pitch load transfer: CG height h + dh", H::kChassis,
        {{"cg_height_delta_m", &E::cg_height_delta_m, "m", kAny, -0.115, 0.12, 0.02}}, {}, false},
       {"motor_voltage_sag", "drive falls with current: throttle u - k max(u,0)^2", H::kActuator,
        {{"voltage_sag", &E::voltage_sag, "1", {0.0, 1.0, Bounds::kOpenHigh}, 0.0, 0.9, 0.05}}, {}, false},
       {"road_grade", "tilted ground plane z = gx x + gy y", H::kForce,
        {{"grade_x", &E::grade_x, "1 (dz/dx)", kGrade, -0.3, 0.3, 0.01},
         {"grade_y", &E::grade_y, "1 (dz/dy)", kGrade, -0.3, 0.3, 0.01}}, {}, false},
+      {"throttle_gain", "motor / ESC gain: throttle u -> g u", H::kActuator,
+       {{"throttle_gain", &E::throttle_gain, "1", kScale, 0.3, 2.5, 0.1}}, {0.7, 1.0, 1.4}, false},
+      {"steer_cubic", "nonlinear steering linkage: s -> s + k s^3", H::kActuator,
+       {{"steer_cubic", &E::steer_cubic, "1", open(-1.0, 2.0), -0.6, 1.0, 0.1}}, {-0.3, 0.3}, false},
+      {"steer_asymmetry", "left and right steering gains differ: x (1 + a) left, x (1 - a) right", H::kActuator,
+       {{"steer_asymmetry", &E::steer_asymmetry, "1", open(-0.9, 0.9), -0.4, 0.4, 0.05}}, {}, false},
+      {"steer_rate_limit", "steering servo speed: the applied steer needs T seconds per unit of change", H::kActuator,
+       {{"steer_slew_s", &E::steer_slew_s, "s (per unit of normalised steer)", kNonNeg, 0.0, 3.0, 0.05}},
+       {0.1, 0.3, 0.8}, false},
+      {"throttle_rate_limit", "throttle ramp: the applied throttle needs T seconds per unit of change", H::kActuator,
+       {{"throttle_slew_s", &E::throttle_slew_s, "s (per unit of normalised throttle)", kNonNeg, 0.0, 3.0, 0.05}},
+       {0.1, 0.3, 0.8}, false},
+      {"steer_backlash", "play of width b between the steering servo and the wheels", H::kActuator,
+       {{"steer_backlash", &E::steer_backlash, "1 (normalised steer)", closed(0.0, 0.5), 0.0, 0.3, 0.02}},
+       {0.02, 0.05, 0.1}, false},
+      {"payload", "mass and yaw inertia differ from the nominal (payload, battery)", H::kChassis,
+       {{"mass_scale", &E::mass_scale, "1", kScale, 0.5, 2.5, 0.1},
+        {"yaw_inertia_scale", &E::yaw_inertia_scale, "1", kScale, 0.5, 2.5, 0.1}}, {0.8, 1.2, 1.5}, false},
+      {"motor_speed", "the drivetrain's torque-speed line: no-load speed x v", H::kChassis,
+       {{"motor_speed_scale", &E::motor_speed_scale, "1", kScale, 0.3, 3.0, 0.1}}, {0.6, 1.0, 1.5}, false},
   };
   return table;
 }
@@ -151,26 +189,37 @@ inline bool EffectParams::is_valid(std::string* why) const {
   return error.empty();
 }
 
-// The nominal single-track parameters with the tyre effects applied. `grip` scales the
+// The nominal single-track parameters with the chassis effects applied. `grip` scales the
 // friction curve (D and Sv).
 inline SingleTrackParams apply_effect_params(SingleTrackParams p, const EffectParams& e, double grip) {
   p.tyre.D *= e.tyre_peak_scale * grip;
   p.tyre.Sv *= grip;
   p.tyre.B *= e.tyre_stiffness_scale / e.tyre_peak_scale;
   p.cg_height_m += e.cg_height_delta_m;
+  p.mass_kg *= e.mass_scale;
+  p.yaw_inertia_kgm2 *= e.yaw_inertia_scale;
+  p.no_load_speed_mps *= e.motor_speed_scale;
   return p;
 }
 
-// Per-step blend factors of the actuator stages, 1 - exp(-dt / tau) (1 for tau = 0); a delay
-// is rolled out as kActuatorDelayStages first-order stages of delay / kActuatorDelayStages each.
+// One actuator channel per step: blend factors 1 - exp(-dt / tau) of its stages (1 for tau = 0;
+// a delay is rolled out as kActuatorDelayStages first-order stages of delay /
+// kActuatorDelayStages each), the largest change of the applied command in one step (rate limit
+// x dt; +inf = none) and the width of its play (backlash; 0 = none).
 inline constexpr int kActuatorDelayStages = 4;
-struct ActuatorAlphas {
-  float steer_delay, steer_lag, throttle_delay, throttle_lag;
+struct ChainCoeffs {
+  float a_delay, a_lag, max_step, backlash;
 };
-inline ActuatorAlphas actuator_alphas(const EffectParams& e, float dt_s) noexcept {
+struct ActuatorCoeffs {
+  ChainCoeffs steer, throttle;
+};
+inline constexpr float kInfF = std::numeric_limits<float>::infinity();
+inline ActuatorCoeffs actuator_coeffs(const EffectParams& e, float dt_s) noexcept {
   auto a = [dt_s](double tau) { return tau > 0 ? static_cast<float>(1.0 - std::exp(-dt_s / tau)) : 1.f; };
-  return {a(e.steer_delay_s / kActuatorDelayStages), a(e.steer_lag_s), a(e.throttle_delay_s / kActuatorDelayStages),
-          a(e.throttle_lag_s)};
+  const auto step = [dt_s](double slew_s) { return slew_s > 0 ? static_cast<float>(dt_s / slew_s) : kInfF; };
+  return {{a(e.steer_delay_s / kActuatorDelayStages), a(e.steer_lag_s), step(e.steer_slew_s),
+           static_cast<float>(e.steer_backlash)},
+          {a(e.throttle_delay_s / kActuatorDelayStages), a(e.throttle_lag_s), step(e.throttle_slew_s), 0.f}};
 }
 
 }  // namespace mppi

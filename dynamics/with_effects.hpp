@@ -6,12 +6,13 @@
 // generator and the corrected model that mppi-sim loads (`--model corrected`). Every effect is
 // off at its default value, so WithEffects<M> with default EffectParams steps exactly like M
 // (plus the bookkeeping states). Each effect enters through its hook:
-//   - actuator: offsets, gain, delays, lags and voltage sag transform the command first;
-//   - tyre: tire_saturation, friction_change and load_transfer change the base's single-track
-//     core parameters (apply_effect_params), with a second base model for the grip after a
-//     change (time is a state). Only for bases with such a core (the single-track and
-//     four-wheel models); the kinematic bicycle and the network have no tyres, so these are
-//     refused;
+//   - actuator: offsets, gains, steering map, delays, lags, rate limits, backlash and voltage
+//     sag transform the command first;
+//   - chassis: tire_saturation, friction_change, load_transfer, payload and motor_speed change
+//     the base's single-track core parameters (apply_effect_params), with a second base model
+//     for the grip after a change (time is a state). Only for bases with such a core (the
+//     single-track and four-wheel models); the kinematic bicycle and the network have none, so
+//     these are refused;
 //   - force: aero_drag, rolling_resistance and road_grade add an acceleration along the body
 //     axes. A base that offers step_with_body_accel (the single-track model) takes it inside
 //     its force balance; for the others it is added to v_x (and v_y where the base has a
@@ -19,7 +20,8 @@
 //     base's own, or for bases without one the AutoRally car's (SingleTrackParams defaults; the
 //     network models that car).
 // State: the base's kNx, then time [s], then the steer and throttle actuator chains
-// (kActuatorDelayStages delay stages followed by one lag stage, whose output is applied).
+// (kActuatorDelayStages delay stages, one lag stage with the rate limit, one play stage for the
+// backlash, whose output is applied).
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -45,7 +47,7 @@ template <class P>
   requires requires(P& p) { { p.base } -> std::convertible_to<SingleTrackParams>; }
 auto& single_track_core(P& p) { return p.base; }
 
-// A base whose parameters hold a single-track core: tyre effects apply.
+// A base whose parameters hold a single-track core: chassis effects apply.
 template <class Base>
 concept HasSingleTrackCore = requires(const Base& b) {
   { single_track_core(b.params()) } -> std::convertible_to<SingleTrackParams>;
@@ -60,10 +62,10 @@ concept HasBodyAccelHook = requires(const Base& b, Batch<Base::kNx, 1> x, ConstB
 template <VehicleDynamics Base>
 class WithEffects {
  public:
-  static constexpr bool kTyreEffects = HasSingleTrackCore<Base>;
+  static constexpr bool kChassisEffects = HasSingleTrackCore<Base>;
   static constexpr bool kLateralVelocity = !std::is_same_v<Base, KinematicBicycle>;  // it pins v_y = 0
   static constexpr int kDelayStages = kActuatorDelayStages;
-  static constexpr int kChain = kDelayStages + 1;
+  static constexpr int kChain = kDelayStages + 2;
   static constexpr int kTime = Base::kNx;
   static constexpr int kSteerChain = kTime + 1;
   static constexpr int kThrottleChain = kSteerChain + kChain;
@@ -80,7 +82,7 @@ class WithEffects {
       : nominal_(nominal), effects_(validated(effects)), before_(with_core(nominal, effects, 1.0)),
         after_(with_core(nominal, effects, effects.grip_scale)) {
     SingleTrackParams car;  // the AutoRally car, for bases without a mass
-    if constexpr (kTyreEffects) car = single_track_core(nominal_.params());
+    if constexpr (kChassisEffects) car = single_track_core(after_.params());  // payload included
     const double m = car.mass_kg, g = car.gravity_mps2;
     drag_per_kg_ = static_cast<float>(effects_.aero_drag_kgpm / m);
     roll_per_kg_ = static_cast<float>(effects_.rolling_force_N / m);
@@ -89,6 +91,14 @@ class WithEffects {
     grade_y_ = static_cast<float>(g * effects_.grade_y);
     change_time_ = static_cast<float>(effects_.grip_change_time_s);
     grip_changes_ = effects_.grip_scale != 1.0;
+    gain_ = static_cast<float>(effects_.steer_gain);
+    offset_ = static_cast<float>(effects_.steer_offset);
+    steer_cubic_ = static_cast<float>(effects_.steer_cubic);
+    left_gain_ = static_cast<float>(1.0 + effects_.steer_asymmetry);
+    right_gain_ = static_cast<float>(1.0 - effects_.steer_asymmetry);
+    throttle_gain_ = static_cast<float>(effects_.throttle_gain);
+    thr_offset_ = static_cast<float>(effects_.throttle_offset);
+    sag_ = static_cast<float>(effects_.voltage_sag);
   }
 
   const Base& nominal() const { return nominal_; }
@@ -96,28 +106,44 @@ class WithEffects {
   std::size_t scratch_floats(int w) const { return before_.scratch_floats(w); }
 
   // Advances one actuator chain (kChain floats) by one step with input u; returns the output.
-  static float advance_chain(float* chain, float u, float a_delay, float a_lag) noexcept {
+  static float advance_chain(float* chain, float u, const ChainCoeffs& k) noexcept {
     float in = u;
     for (int i = 0; i < kDelayStages; ++i) {
-      chain[i] += a_delay * (in - chain[i]);
+      chain[i] += k.a_delay * (in - chain[i]);
       in = chain[i];
     }
-    chain[kDelayStages] += a_lag * (in - chain[kDelayStages]);
-    return chain[kDelayStages];
+    float& lag = chain[kDelayStages];
+    lag += std::clamp(k.a_lag * (in - lag), -k.max_step, k.max_step);  // +-inf: no rate limit
+    float& play = chain[kDelayStages + 1];
+    if (k.backlash > 0.f) {  // the output moves only when the input pushes against a side
+      const float half = 0.5f * k.backlash;
+      play = std::clamp(play, lag - half, lag + half);
+    } else {
+      play = lag;
+    }
+    return play;
   }
 
   // Actuator chains only, one state (used to prime them from a command history).
   void advance_actuators(float* x, float steer, float throttle, float dt_s) const noexcept {
-    const ActuatorAlphas al = actuator_alphas(effects_, dt_s);
-    advance_chain(x + kSteerChain, steer, al.steer_delay, al.steer_lag);
-    advance_chain(x + kThrottleChain, throttle, al.throttle_delay, al.throttle_lag);
+    const ActuatorCoeffs k = actuator_coeffs(effects_, dt_s);
+    advance_chain(x + kSteerChain, steer, k.steer);
+    advance_chain(x + kThrottleChain, throttle, k.throttle);
+  }
+
+  // The command the base model sees from the chains' outputs.
+  float applied_steer(float s) const noexcept {
+    const float mapped = s + steer_cubic_ * s * s * s;
+    return gain_ * (mapped * (mapped > 0.f ? left_gain_ : right_gain_)) + offset_;
+  }
+  float applied_throttle(float t) const noexcept {
+    const float t_pos = std::max(t, 0.f);
+    return throttle_gain_ * t + thr_offset_ - sag_ * t_pos * t_pos;
   }
 
   template <int W>
   void step(Batch<kNx, W> x, ConstBatch<kNu, W> u, float dt_s, float* scratch) const noexcept {
-    const ActuatorAlphas al = actuator_alphas(effects_, dt_s);
-    const float gain = static_cast<float>(effects_.steer_gain), offset = static_cast<float>(effects_.steer_offset);
-    const float sag = static_cast<float>(effects_.voltage_sag), thr_offset = static_cast<float>(effects_.throttle_offset);
+    const ActuatorCoeffs k = actuator_coeffs(effects_, dt_s);
     float applied[kNu * W];  // the command the base model sees, per lane
     float ax[W], ay[W];      // force hook: body-axis accelerations from the start-of-step state
     int before_lanes = 0;
@@ -127,15 +153,14 @@ class WithEffects {
         chain_s[i] = x[kSteerChain + i][j];
         chain_t[i] = x[kThrottleChain + i][j];
       }
-      const float s = advance_chain(chain_s, u[control::kSteer][j], al.steer_delay, al.steer_lag);
-      const float t = advance_chain(chain_t, u[control::kThrottle][j], al.throttle_delay, al.throttle_lag);
+      const float s = advance_chain(chain_s, u[control::kSteer][j], k.steer);
+      const float t = advance_chain(chain_t, u[control::kThrottle][j], k.throttle);
       for (int i = 0; i < kChain; ++i) {
         x[kSteerChain + i][j] = chain_s[i];
         x[kThrottleChain + i][j] = chain_t[i];
       }
-      const float t_pos = std::max(t, 0.f);
-      applied[control::kSteer * W + j] = gain * s + offset;
-      applied[control::kThrottle * W + j] = t + thr_offset - sag * t_pos * t_pos;
+      applied[control::kSteer * W + j] = applied_steer(s);
+      applied[control::kThrottle * W + j] = applied_throttle(t);
       const float vx = x[state::kVx][j];
       float sy, cy;
       fast_sincos(x[state::kYaw][j], &sy, &cy);
@@ -192,7 +217,7 @@ class WithEffects {
   }
 
   static Base with_core(const Base& b, const EffectParams& e, double grip) {
-    if constexpr (kTyreEffects) {
+    if constexpr (kChassisEffects) {
       auto p = b.params();
       single_track_core(p) = apply_effect_params(single_track_core(p), e, grip);
       std::string why;
@@ -201,10 +226,10 @@ class WithEffects {
       return Base(p);
     } else {
       for (const EffectSpec& spec : effect_table()) {
-        if (spec.hook != EffectHook::kTyre) continue;
+        if (spec.hook != EffectHook::kChassis) continue;
         for (const EffectParamSpec& q : spec.params)
           if (e.*(q.member) != EffectParams{}.*(q.member))
-            throw Error("WithEffects: " + spec.id + " needs a tyre model; this base model has none");
+            throw Error("WithEffects: " + spec.id + " needs a chassis model (mass, tyres); this base model has none");
       }
       return b;
     }
@@ -220,6 +245,8 @@ class WithEffects {
   Base before_, after_;
   float drag_per_kg_ = 0, roll_per_kg_ = 0, visc_per_kg_ = 0, grade_x_ = 0, grade_y_ = 0, change_time_ = 0;
   bool grip_changes_ = false;
+  float gain_ = 1, offset_ = 0, steer_cubic_ = 0, left_gain_ = 1, right_gain_ = 1;  // steering map
+  float throttle_gain_ = 1, thr_offset_ = 0, sag_ = 0;                              // throttle map
 };
 
 using CorrectedSingleTrack = WithEffects<SingleTrack>;

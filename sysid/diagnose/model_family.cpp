@@ -46,7 +46,7 @@ class WrappedFamily final : public ModelFamily {
     return std::make_unique<ReplayModelOf<WithEffects<Base>>>(WithEffects<Base>(nominal_, e));
   }
   bool supports(const std::string& effect_id) const override {
-    return WithEffects<Base>::kTyreEffects || effect_spec(effect_id).hook != EffectHook::kTyre;
+    return WithEffects<Base>::kChassisEffects || effect_spec(effect_id).hook != EffectHook::kChassis;
   }
   CorrectedModelFile file(const EffectParams& e, const std::vector<std::string>& selected) const override {
     CorrectedModelFile f = file_;

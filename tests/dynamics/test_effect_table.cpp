@@ -106,7 +106,7 @@ TEMPLATE_LIST_TEST_CASE("force effects add their closed-form acceleration in one
   const Base base = default_base<D>();
   const M wrapped(base, e);
   double mass_kg = SingleTrackParams{}.mass_kg, g = SingleTrackParams{}.gravity_mps2;
-  if constexpr (M::kTyreEffects) {
+  if constexpr (M::kChassisEffects) {
     mass_kg = single_track_core(base.params()).mass_kg;
     g = single_track_core(base.params()).gravity_mps2;
   }
@@ -134,4 +134,113 @@ TEST_CASE("tyre effects are refused where the model has no tyres, with the effec
   e.cg_height_delta_m = 0.05;
   CHECK_THROWS_WITH(KinematicWithEffects(KinematicBicycle(), e), Catch::Contains("load_transfer"));
   CHECK_NOTHROW(CorrectedSingleTrack(SingleTrack(), e));
+}
+
+namespace {
+
+// The applied (last-stage) output of the steer and throttle chains.
+template <class M>
+float applied_steer_stage(const float* x) { return x[M::kSteerChain + M::kChain - 1]; }
+template <class M>
+float applied_throttle_stage(const float* x) { return x[M::kThrottleChain + M::kChain - 1]; }
+
+// Steps base and wrapped model side by side from the same start; the wrapped one gets command
+// u, the base one command u_base. Returns the largest state difference.
+float max_difference_after(const SingleTrack& base, const CorrectedSingleTrack& wrapped, const float u[2],
+                           const float u_base[2], int steps) {
+  float xb[SingleTrack::kNx], xw[CorrectedSingleTrack::kNx];
+  std::vector<float> scratch(std::max<std::size_t>(1, base.scratch_floats(1)));
+  start(base, xb, 4.f);
+  start(wrapped, xw, 4.f);
+  wrapped.set_actuators(xw, u[0], u[1]);
+  float worst = 0;
+  for (int k = 0; k < steps; ++k) {
+    base.step<1>(Batch<SingleTrack::kNx, 1>{xb}, ConstBatch<2, 1>{u_base}, 0.002f, scratch.data());
+    wrapped.step<1>(Batch<CorrectedSingleTrack::kNx, 1>{xw}, ConstBatch<2, 1>{u}, 0.002f, scratch.data());
+  }
+  for (int i = 0; i < SingleTrack::kNx; ++i) worst = std::max(worst, std::abs(xw[i] - xb[i]));
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("a rate limit moves the applied command at most r per second", "[effects]") {
+  EffectParams e;
+  e.steer_slew_s = 0.5;     // 2 per second
+  e.throttle_slew_s = 2.0;  // 0.5 per second
+  using M = CorrectedSingleTrack;
+  const M m(SingleTrack(), e);
+  float x[M::kNx] = {};
+  m.set_actuators(x, 0.f, 0.f);
+  const float dt_s = 0.01f;
+  for (int k = 1; k <= 80; ++k) {
+    m.advance_actuators(x, 1.f, 1.f, dt_s);  // a step from 0 to 1 at t = 0
+    const double t = k * dt_s;
+    CHECK(applied_steer_stage<M>(x) == Approx(std::min(1.0, 2.0 * t)).margin(1e-5));
+    CHECK(applied_throttle_stage<M>(x) == Approx(std::min(1.0, 0.5 * t)).margin(1e-5));
+  }
+}
+
+TEST_CASE("steering backlash is a play operator of the given width", "[effects]") {
+  EffectParams e;
+  e.steer_backlash = 0.1;  // half width h = 0.05
+  using M = CorrectedSingleTrack;
+  const M m(SingleTrack(), e);
+  float x[M::kNx] = {};
+  m.set_actuators(x, 0.f, 0.f);
+  // Up from 0 to 0.5: the wheels trail the servo by h. Down again: they stay at 0.45 until the
+  // servo has crossed the play (0.5 -> 0.4), then trail by h on the other side.
+  double in = 0.0;
+  for (int k = 1; k <= 50; ++k) {
+    in = 0.01 * k;
+    m.advance_actuators(x, static_cast<float>(in), 0.f, 0.01f);
+    CHECK(applied_steer_stage<M>(x) == Approx(std::max(0.0, in - 0.05)).margin(1e-5));
+  }
+  for (int k = 1; k <= 50; ++k) {
+    in = 0.5 - 0.01 * k;
+    m.advance_actuators(x, static_cast<float>(in), 0.f, 0.01f);
+    const double expected = in > 0.4 ? 0.45 : in + 0.05;
+    CHECK(applied_steer_stage<M>(x) == Approx(expected).margin(1e-5));
+  }
+}
+
+TEST_CASE("command maps equal the base model driven with the mapped command", "[effects]") {
+  const SingleTrack base;
+  const float u[2] = {0.3f, 0.6f};
+  SECTION("cubic steering") {
+    EffectParams e;
+    e.steer_cubic = 0.5;
+    const float ub[2] = {0.3f + 0.5f * 0.027f, 0.6f};
+    CHECK(max_difference_after(base, CorrectedSingleTrack(base, e), u, ub, 300) < 1e-4f);
+  }
+  SECTION("asymmetric steering, left and right") {
+    EffectParams e;
+    e.steer_asymmetry = 0.2;
+    const float ub_left[2] = {0.36f, 0.6f};
+    CHECK(max_difference_after(base, CorrectedSingleTrack(base, e), u, ub_left, 300) < 1e-4f);
+    const float u_right[2] = {-0.3f, 0.6f}, ub_right[2] = {-0.24f, 0.6f};
+    CHECK(max_difference_after(base, CorrectedSingleTrack(base, e), u_right, ub_right, 300) < 1e-4f);
+  }
+  SECTION("throttle gain") {
+    EffectParams e;
+    e.throttle_gain = 1.5;
+    const float ub[2] = {0.3f, 0.9f};
+    CHECK(max_difference_after(base, CorrectedSingleTrack(base, e), u, ub, 300) < 1e-4f);
+    // and the map is really applied: the unmapped command differs.
+    CHECK(max_difference_after(base, CorrectedSingleTrack(base, e), u, u, 300) > 1e-2f);
+  }
+}
+
+TEST_CASE("payload and motor speed equal the base model with its mass, inertia and motor changed", "[effects]") {
+  EffectParams e;
+  e.mass_scale = 1.25;
+  e.yaw_inertia_scale = 1.4;
+  e.motor_speed_scale = 0.8;
+  SingleTrackParams heavy;
+  heavy.mass_kg *= 1.25;
+  heavy.yaw_inertia_kgm2 *= 1.4;
+  heavy.no_load_speed_mps *= 0.8;
+  const float u[2] = {0.25f, 0.7f};
+  CHECK(max_difference_after(SingleTrack(heavy), CorrectedSingleTrack(SingleTrack(), e), u, u, 500) < 1e-5f);
+  CHECK(max_difference_after(SingleTrack(), CorrectedSingleTrack(SingleTrack(), e), u, u, 500) > 1e-2f);
 }
