@@ -26,6 +26,15 @@
 //             load_transfer               CG height h -> h + dh (pitch load transfer)
 //             payload                     mass x m, yaw inertia x j
 //             motor_speed                 no-load speed x v (the motor's torque-speed line)
+//   sensor:   gyro_bias                   the yaw-rate gyro reads r + b
+//             speed_sensor_scale          the velocity sensor reads s (vx, vy)
+//             time_offset                 states are stamped t_off late against the commands.
+//                                         A late stamp looks exactly like equal delays of both
+//                                         actuators, so the diagnosis searches only early stamps
+//                                         (t_off < 0: responses before their commands, which no
+//                                         physics can produce). Sensor effects change what
+//                                         a recording shows, not the car: the diagnosis' replay
+//                                         applies them, WithEffects' physics ignores them.
 //   force:    aero_drag                   extra force -c vx |vx|
 //             rolling_resistance          extra force -(F0 tanh(vx / 0.5) + b vx)
 //             road_grade                  a tilted plane z = gx x + gy y: -m g grad z
@@ -69,6 +78,9 @@ struct EffectParams {
   double mass_scale = 1.0;           // [-] payload: mass x m
   double yaw_inertia_scale = 1.0;    // [-] payload: yaw inertia x j
   double motor_speed_scale = 1.0;    // [-] no-load speed x v
+  double gyro_bias_radps = 0.0;      // [rad/s] measured yaw rate = r + b
+  double speed_scale = 1.0;          // [-] measured vx, vy = s x true
+  double time_offset_s = 0.0;        // [s] states stamped late against the commands
 
   bool is_valid(std::string* why) const;
 };
@@ -79,6 +91,7 @@ enum class EffectHook {
   kChassis,   // changes the model's tyre / chassis parameters (models with a single-track core)
   kForce,     // adds a force along the body axes (inside the force balance where the model
               // offers it, else after the model's step)
+  kSensor,    // changes what the recording shows (measured states, time stamps), not the car
 };
 
 struct EffectParamSpec {
@@ -90,6 +103,17 @@ struct EffectParamSpec {
   double scale;                 // typical size: finite-difference step = 0.01 scale
 };
 
+// What a recording must contain for an effect to be identifiable from it (the diagnosis
+// measures it on the data; sysid/diagnose/identifiability.hpp).
+enum class Excitation {
+  kAny,         // any driving
+  kSteer,       // steering that changes (and turns the car)
+  kThrottle,    // throttle that changes (and changes the speed)
+  kCornering,   // lateral acceleration towards the tyres' limit
+  kSpeedRange,  // a range of speeds (speed-dependent forces)
+  kBraking,     // longitudinal acceleration and braking (pitch load transfer)
+};
+
 struct EffectSpec {
   std::string id;               // effect id, e.g. "steer_delay"
   std::string description;      // one line, physical meaning
@@ -97,68 +121,76 @@ struct EffectSpec {
   std::vector<EffectParamSpec> params;
   std::vector<double> grid;     // start values searched for params[0] (empty: its default)
   bool time_grid = false;       // params[0] is a time searched over the data (not LM-fitted)
+  Excitation needs = Excitation::kAny;
 };
 
 // Every effect, in a fixed order.
 inline const std::vector<EffectSpec>& effect_table() {
   using E = EffectParams;
   using H = EffectHook;
+  using X = Excitation;
   static const Range kAny = any_finite(), kNonNeg = non_negative(), kScale = {0.05, kInf, Bounds::kOpen},
                      kGrade = open(-0.5, 0.5);
   static const std::vector<EffectSpec> table = {
       {"aero_drag", "extra air drag F = -c vx|vx|", H::kForce,
-       {{"aero_drag_kgpm", &E::aero_drag_kgpm, "N s^2/m^2", kAny, -0.05, 3.0, 0.1}}, {}, false},
+       {{"aero_drag_kgpm", &E::aero_drag_kgpm, "N s^2/m^2", kAny, -0.05, 3.0, 0.1}}, {}, false, X::kSpeedRange},
       {"rolling_resistance", "extra rolling resistance F = -(F0 tanh(vx/0.5) + b vx)", H::kForce,
        {{"rolling_force_N", &E::rolling_force_N, "N", kAny, -10.0, 60.0, 2.0},
-        {"rolling_viscous_Nspm", &E::rolling_viscous_Nspm, "N s/m", kAny, -5.0, 30.0, 1.0}}, {}, false},
+        {"rolling_viscous_Nspm", &E::rolling_viscous_Nspm, "N s/m", kAny, -5.0, 30.0, 1.0}}, {}, false, X::kSpeedRange},
       {"steer_delay", "pure delay of the steering command", H::kActuator,
-       {{"steer_delay_s", &E::steer_delay_s, "s", kNonNeg, 0.0, 0.4, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25}, false},
+       {{"steer_delay_s", &E::steer_delay_s, "s", kNonNeg, 0.0, 0.4, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25}, false, X::kSteer},
       {"throttle_delay", "pure delay of the throttle command", H::kActuator,
        {{"throttle_delay_s", &E::throttle_delay_s, "s", kNonNeg, 0.0, 0.4, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25},
-       false},
+       false, X::kThrottle},
       {"steer_lag", "first-order steering actuator", H::kActuator,
-       {{"steer_lag_s", &E::steer_lag_s, "s", kNonNeg, 0.0, 0.6, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25}, false},
+       {{"steer_lag_s", &E::steer_lag_s, "s", kNonNeg, 0.0, 0.6, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25}, false, X::kSteer},
       {"throttle_lag", "first-order throttle / motor response", H::kActuator,
-       {{"throttle_lag_s", &E::throttle_lag_s, "s", kNonNeg, 0.0, 1.0, 0.05}}, {0.03, 0.06, 0.1, 0.2, 0.4}, false},
+       {{"throttle_lag_s", &E::throttle_lag_s, "s", kNonNeg, 0.0, 1.0, 0.05}}, {0.03, 0.06, 0.1, 0.2, 0.4}, false, X::kThrottle},
       {"steer_offset", "steering bias (trim)", H::kActuator,
-       {{"steer_offset", &E::steer_offset, "1 (normalised steer)", kAny, -0.4, 0.4, 0.02}}, {}, false},
+       {{"steer_offset", &E::steer_offset, "1 (normalised steer)", kAny, -0.4, 0.4, 0.02}}, {}, false, X::kAny},
       {"steer_gain", "steering scale (servo / linkage gain)", H::kActuator,
-       {{"steer_gain", &E::steer_gain, "1", kAny, 0.3, 2.0, 0.1}}, {0.7, 1.0, 1.3}, false},
+       {{"steer_gain", &E::steer_gain, "1", kAny, 0.3, 2.0, 0.1}}, {0.7, 1.0, 1.3}, false, X::kSteer},
       {"throttle_offset", "throttle bias / motor dead band", H::kActuator,
-       {{"throttle_offset", &E::throttle_offset, "1 (normalised throttle)", kAny, -0.4, 0.4, 0.02}}, {}, false},
+       {{"throttle_offset", &E::throttle_offset, "1 (normalised throttle)", kAny, -0.4, 0.4, 0.02}}, {}, false, X::kThrottle},
       {"tire_saturation", "tyre friction limit (Pacejka peak D x k) and cornering stiffness (x s)", H::kChassis,
        {{"tyre_peak_scale", &E::tyre_peak_scale, "1", kScale, 0.3, 3.0, 0.1},
-        {"tyre_stiffness_scale", &E::tyre_stiffness_scale, "1", kScale, 0.2, 5.0, 0.1}}, {0.6, 1.0, 1.4}, false},
+        {"tyre_stiffness_scale", &E::tyre_stiffness_scale, "1", kScale, 0.2, 5.0, 0.1}}, {0.6, 1.0, 1.4}, false, X::kCornering},
       {"friction_change", "grip (whole friction curve) x g from time t_change on", H::kChassis,
        {{"grip_change_time_s", &E::grip_change_time_s, "s", kAny, 0.0, 1e9, 1.0},
-        {"grip_scale", &E::grip_scale, "1", kScale, 0.3, 3.0, 0.1}}, {}, true},
+        {"grip_scale", &E::grip_scale, "1", kScale, 0.3, 3.0, 0.1}}, {}, true, X::kCornering},
       {"load_transfer", "pitch load transfer: CG height h + dh", H::kChassis,
-       {{"cg_height_delta_m", &E::cg_height_delta_m, "m", kAny, -0.115, 0.12, 0.02}}, {}, false},
+       {{"cg_height_delta_m", &E::cg_height_delta_m, "m", kAny, -0.115, 0.12, 0.02}}, {}, false, X::kBraking},
       {"motor_voltage_sag", "drive falls with current: throttle u - k max(u,0)^2", H::kActuator,
-       {{"voltage_sag", &E::voltage_sag, "1", {0.0, 1.0, Bounds::kOpenHigh}, 0.0, 0.9, 0.05}}, {}, false},
+       {{"voltage_sag", &E::voltage_sag, "1", {0.0, 1.0, Bounds::kOpenHigh}, 0.0, 0.9, 0.05}}, {}, false, X::kThrottle},
       {"road_grade", "tilted ground plane z = gx x + gy y", H::kForce,
        {{"grade_x", &E::grade_x, "1 (dz/dx)", kGrade, -0.3, 0.3, 0.01},
-        {"grade_y", &E::grade_y, "1 (dz/dy)", kGrade, -0.3, 0.3, 0.01}}, {}, false},
+        {"grade_y", &E::grade_y, "1 (dz/dy)", kGrade, -0.3, 0.3, 0.01}}, {}, false, X::kAny},
       {"throttle_gain", "motor / ESC gain: throttle u -> g u", H::kActuator,
-       {{"throttle_gain", &E::throttle_gain, "1", kScale, 0.3, 2.5, 0.1}}, {0.7, 1.0, 1.4}, false},
+       {{"throttle_gain", &E::throttle_gain, "1", kScale, 0.3, 2.5, 0.1}}, {0.7, 1.0, 1.4}, false, X::kThrottle},
       {"steer_cubic", "nonlinear steering linkage: s -> s + k s^3", H::kActuator,
-       {{"steer_cubic", &E::steer_cubic, "1", open(-1.0, 2.0), -0.6, 1.0, 0.1}}, {-0.3, 0.3}, false},
+       {{"steer_cubic", &E::steer_cubic, "1", open(-1.0, 2.0), -0.6, 1.0, 0.1}}, {-0.3, 0.3}, false, X::kSteer},
       {"steer_asymmetry", "left and right steering gains differ: x (1 + a) left, x (1 - a) right", H::kActuator,
-       {{"steer_asymmetry", &E::steer_asymmetry, "1", open(-0.9, 0.9), -0.4, 0.4, 0.05}}, {}, false},
+       {{"steer_asymmetry", &E::steer_asymmetry, "1", open(-0.9, 0.9), -0.4, 0.4, 0.05}}, {}, false, X::kSteer},
       {"steer_rate_limit", "steering servo speed: the applied steer needs T seconds per unit of change", H::kActuator,
        {{"steer_slew_s", &E::steer_slew_s, "s (per unit of normalised steer)", kNonNeg, 0.0, 3.0, 0.05}},
-       {0.1, 0.3, 0.8}, false},
+       {0.1, 0.3, 0.8}, false, X::kSteer},
       {"throttle_rate_limit", "throttle ramp: the applied throttle needs T seconds per unit of change", H::kActuator,
        {{"throttle_slew_s", &E::throttle_slew_s, "s (per unit of normalised throttle)", kNonNeg, 0.0, 3.0, 0.05}},
-       {0.1, 0.3, 0.8}, false},
+       {0.1, 0.3, 0.8}, false, X::kThrottle},
       {"steer_backlash", "play of width b between the steering servo and the wheels", H::kActuator,
        {{"steer_backlash", &E::steer_backlash, "1 (normalised steer)", closed(0.0, 0.5), 0.0, 0.3, 0.02}},
-       {0.02, 0.05, 0.1}, false},
+       {0.02, 0.05, 0.1}, false, X::kSteer},
       {"payload", "mass and yaw inertia differ from the nominal (payload, battery)", H::kChassis,
        {{"mass_scale", &E::mass_scale, "1", kScale, 0.5, 2.5, 0.1},
-        {"yaw_inertia_scale", &E::yaw_inertia_scale, "1", kScale, 0.5, 2.5, 0.1}}, {0.8, 1.2, 1.5}, false},
+        {"yaw_inertia_scale", &E::yaw_inertia_scale, "1", kScale, 0.5, 2.5, 0.1}}, {0.8, 1.2, 1.5}, false, X::kThrottle},
       {"motor_speed", "the drivetrain's torque-speed line: no-load speed x v", H::kChassis,
-       {{"motor_speed_scale", &E::motor_speed_scale, "1", kScale, 0.3, 3.0, 0.1}}, {0.6, 1.0, 1.5}, false},
+       {{"motor_speed_scale", &E::motor_speed_scale, "1", kScale, 0.3, 3.0, 0.1}}, {0.6, 1.0, 1.5}, false, X::kSpeedRange},
+      {"gyro_bias", "sensor fault: the yaw-rate gyro reads r + b", H::kSensor,
+       {{"gyro_bias_radps", &E::gyro_bias_radps, "rad/s", kAny, -0.5, 0.5, 0.01}}, {}, false, X::kAny},
+      {"speed_sensor_scale", "sensor fault: the velocity sensor reads s x (vx, vy)", H::kSensor,
+       {{"speed_scale", &E::speed_scale, "1", kScale, 0.5, 1.5, 0.02}}, {}, false, X::kAny},
+      {"time_offset", "sensor fault: states stamped t late against the commands (negative: early)", H::kSensor,
+       {{"time_offset_s", &E::time_offset_s, "s", open(-0.5, 0.5), -0.3, 0.0, 0.01}}, {-0.1, -0.04}, false, X::kSteer},
   };
   return table;
 }

@@ -79,8 +79,10 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
   if (file.effects.grip_change_time_s > 0 && file.effects.grip_scale != 1.0) {
     file.effects.grip_change_time_s = 0.0;
   }
-  if (!o.out_dir.empty()) {
-    std::filesystem::create_directories(o.out_dir);
+  if (!o.out_dir.empty()) std::filesystem::create_directories(o.out_dir);
+  if (!o.out_dir.empty() && !res.selection.reliable) {
+    std::filesystem::remove(o.out_dir + "/corrected_model.yaml");  // none is trusted: none is left behind
+  } else if (!o.out_dir.empty()) {
     res.model_file = o.out_dir + "/corrected_model.yaml";
     std::ofstream mf(res.model_file);
     if (!mf) throw Error("cannot write " + res.model_file);
@@ -97,6 +99,20 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
   j["dt_s"] = d.dt_s;
   j["holdout"] = o.holdout;
   j["selected"] = res.selection.selected;
+  j["reliable"] = res.selection.reliable;
+  j["verdict"] = res.selection.verdict;
+  j["sensor_faults"] = json::array();
+  for (const auto& id : res.selection.selected)
+    if (effect_spec(id).hook == EffectHook::kSensor) j["sensor_faults"].push_back(id);
+  json suspected = json::array();
+  for (const auto& s : res.selection.suspected) {
+    json ps;
+    for (const auto& p : s.params) ps[p.name] = {{"value", num(p.value)}, {"unit", p.unit}};
+    suspected.push_back({{"id", s.id}, {"reason", s.reason}, {"params", ps}});
+  }
+  j["suspected"] = suspected;
+  j["heldout_1s_normalized_rmse"] = {{"nominal", num(res.selection.heldout_nominal)},
+                                     {"corrected", num(res.selection.heldout_corrected)}};
   json effects = json::array();
   for (const auto& c : res.selection.candidates) {
     json e;
@@ -109,6 +125,8 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
     e["heldout_improvement"] = num(c.heldout_improvement);
     e["selected"] = c.selected;
     if (c.selected) e["round"] = c.round_selected;
+    if (!c.not_testable.empty()) e["not_testable"] = c.not_testable;
+    if (c.inclusion_frequency >= 0) e["inclusion_frequency"] = c.inclusion_frequency;
     effects.push_back(e);
   }
   j["effects"] = effects;
@@ -162,9 +180,31 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
     md << "# Sim-vs-real diagnosis\n\n"
        << "- recording: `" << d.source << "` (" << d.rows() << " rows, dt " << d.dt_s << " s), held out: `" << o.holdout
        << "`\n- nominal model: " << nominal.name() << (o.params_source.empty() ? " (library defaults)" : " from `" + o.params_source + "`")
-       << "\n- corrected model: `" << res.model_file << "`\n\n## Named effects\n\n";
-    if (res.selection.selected.empty()) md << "None: no candidate improved the validation error enough (the nominal model stands).\n";
-    for (const auto& id : res.selection.selected) md << "- **" << id << "**: " << effect_spec(id).description << "\n";
+       << "\n- corrected model: " << (res.model_file.empty() ? std::string("none written") : "`" + res.model_file + "`")
+       << "\n- verdict: **" << res.selection.verdict << "**\n\n## Named effects\n\n";
+    auto inclusion = [&](const std::string& id) {
+      for (const auto& c : res.selection.candidates)
+        if (c.id == id && c.inclusion_frequency >= 0) return " (chosen in " + std::to_string(std::lround(100 * c.inclusion_frequency)) + " % of resamples)";
+      return std::string();
+    };
+    int physics = 0, sensors = 0;
+    for (const auto& id : res.selection.selected) (effect_spec(id).hook == EffectHook::kSensor ? sensors : physics)++;
+    if (physics == 0) md << "No missing physics named.\n";
+    for (const auto& id : res.selection.selected)
+      if (effect_spec(id).hook != EffectHook::kSensor) md << "- **" << id << "**: " << effect_spec(id).description << inclusion(id) << "\n";
+    if (sensors > 0) {
+      md << "\n## Sensor faults (what the recording shows, not the car)\n\n";
+      for (const auto& id : res.selection.selected)
+        if (effect_spec(id).hook == EffectHook::kSensor) md << "- **" << id << "**: " << effect_spec(id).description << inclusion(id) << "\n";
+    }
+    if (!res.selection.suspected.empty()) {
+      md << "\n## Suspected, not identifiable from this recording\n\n| effect | why not named | fitted |\n|---|---|---|\n";
+      for (const auto& s : res.selection.suspected) {
+        md << "| " << s.id << " | " << s.reason << " | ";
+        for (const auto& p : s.params) md << p.name << " = " << p.value << "; ";
+        md << " |\n";
+      }
+    }
     md << "\nFinal parameters (joint refit, 1-sigma):\n\n| parameter | value | stddev | unit |\n|---|---|---|---|\n";
     for (const auto& p : res.selection.final_params)
       md << "| " << p.name << " | " << p.value << " | " << p.stddev << " | " << p.unit << " |\n";
@@ -174,11 +214,16 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
       const auto& m = res.mismatch[i];
       md << "| " << m.channel << " | " << m.where << " | " << m.magnitude << " " << m.unit << " | " << m.rms << " | " << m.z << " |\n";
     }
-    md << "\n## Candidates (each alone on the nominal model)\n\n| effect | params | validation improvement | dBIC | held-out improvement | selected |\n|---|---|---|---|---|---|\n";
+    md << "\n## Candidates (each alone on the nominal model)\n\n| effect | params | validation improvement | dBIC | held-out improvement | inclusion | selected |\n|---|---|---|---|---|---|---|\n";
     for (const auto& c : res.selection.candidates) {
+      if (!c.not_testable.empty()) {
+        md << "| " << c.id << " | not testable: " << c.not_testable << " | | | | | |\n";
+        continue;
+      }
       md << "| " << c.id << " | ";
       for (const auto& p : c.params) md << p.name << " = " << p.value << " +- " << p.stddev << "; ";
       md << " | " << 100 * c.val_improvement << " % | " << c.bic_delta << " | " << 100 * c.heldout_improvement << " % | "
+         << (c.inclusion_frequency >= 0 ? std::to_string(std::lround(100 * c.inclusion_frequency)) + " %" : "") << " | "
          << (c.selected ? "yes" : "") << " |\n";
     }
     md << "\n## Held-out fit before -> after\n\n| horizon | channel | fit % before | fit % after | RMSE before | RMSE after |\n|---|---|---|---|---|---|\n";

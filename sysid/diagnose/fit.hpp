@@ -4,6 +4,7 @@
 // search) on multi-step open-loop residuals, and greedy forward selection judged on
 // validation segments with the BIC, so that an effect that does not help is not named.
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,9 @@ struct FitProblem {
   std::array<double, kChannels> scale{};
   ReplayOptions replay;
 };
+
+// The family's member with these effects, or nullptr where the values make it invalid.
+std::unique_ptr<ReplayModel> make_member_or_null(const ModelFamily& family, const EffectParams& e);
 
 // Mean squared weighted residual of a model on a problem.
 double mean_cost(const FitProblem& p, const EffectParams& e);
@@ -54,6 +58,18 @@ struct SelectionOptions {
   double samples_per_independent = 5.0;  // residual correlation: samples per independent one
   int max_effects = 3;
   std::vector<std::string> candidates;  // empty = the whole library
+  // Forward validation: the last part of the training data (in time) judges what the earlier
+  // part fitted, so an effect must hold on data that come later.
+  double validation_fraction = 0.3;
+  // Stability selection: the selection is repeated on block-bootstrap resamples of the fit
+  // segments; an effect is named only when chosen in at least this share of them.
+  int stability_resamples = 6;
+  double min_inclusion_frequency = 0.65;
+  std::uint64_t seed = 1;
+  double range_limit_margin = 0.01;  // fraction of a search range that counts as "at its end"
+  // A time-indexed change is named only when no state-dependent candidate explains at least
+  // this share of its validation improvement.
+  double time_change_dominance = 0.8;
 };
 
 struct CandidateReport {
@@ -64,18 +80,31 @@ struct CandidateReport {
   double heldout_improvement = 0;     // relative held-out 1-s normalised RMSE reduction
   bool selected = false;
   int round_selected = 0;
+  std::string not_testable;           // why the recording cannot identify it (then not fitted)
+  double inclusion_frequency = -1;    // share of stability resamples that chose it (-1: not resampled)
+};
+
+// An effect the data point to but do not pin down: reported, not named, not in the model file.
+struct SuspectedEffect {
+  std::string id;
+  std::string reason;
+  std::vector<ParamEstimate> params;
 };
 
 struct Selection {
-  std::vector<std::string> selected;            // in the order chosen
-  std::vector<CandidateReport> candidates;      // every candidate tried
+  std::vector<std::string> selected;            // named, in the order chosen
+  std::vector<CandidateReport> candidates;      // every candidate considered
+  std::vector<SuspectedEffect> suspected;       // "suspected, not identifiable from this recording"
   std::vector<ParamEstimate> final_params;      // joint refit of the selected effects
   EffectParams final_effects;
+  bool reliable = true;                         // false: "no reliable correction" (none written)
+  std::string verdict;                          // one line: what was concluded
+  double heldout_nominal = 0, heldout_corrected = 0;  // held-out 1-s normalised RMSE
   std::vector<std::string> log;                 // one line per round / decision
 };
 
-// Runs the selection on the training rows (train_mask), reporting held-out numbers on
-// heldout_mask.
+// Runs the selection on the training rows (train_mask) and judges the corrected model on the
+// held-out rows (heldout_mask): when it is not better than the nominal there, nothing is named.
 Selection select_effects(const DiagData& d, const ModelFamily& nominal,
                          const std::vector<char>& train_mask, const std::vector<char>& heldout_mask,
                          const SelectionOptions& options = {}, const ReplayOptions& replay = {});

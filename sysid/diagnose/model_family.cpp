@@ -43,7 +43,9 @@ class WrappedFamily final : public ModelFamily {
   }
   const std::string& name() const override { return file_.nominal_model; }
   std::unique_ptr<ReplayModel> make(const EffectParams& e) const override {
-    return std::make_unique<ReplayModelOf<WithEffects<Base>>>(WithEffects<Base>(nominal_, e));
+    auto m = std::make_unique<ReplayModelOf<WithEffects<Base>>>(WithEffects<Base>(nominal_, e));
+    m->sensor = SensorFaults::of(e);
+    return m;
   }
   bool supports(const std::string& effect_id) const override {
     return WithEffects<Base>::kChassisEffects || effect_spec(effect_id).hook != EffectHook::kChassis;

@@ -12,9 +12,19 @@
 
 namespace mppi::diagnose {
 
+// What a recording's sensors add to the car's true states (the sensor effects of
+// dynamics/effects.hpp); the replay reads measurements through it and predicts measurements.
+struct SensorFaults {
+  double gyro_bias_radps = 0.0;  // measured yaw rate = r + b
+  double speed_scale = 1.0;      // measured vx, vy = s x true
+  double time_offset_s = 0.0;    // states stamped this late against the commands
+  static SensorFaults of(const EffectParams& e) { return {e.gyro_bias_radps, e.speed_scale, e.time_offset_s}; }
+};
+
 class ReplayModel {
  public:
   static constexpr int kMaxStates = 64;
+  SensorFaults sensor;
   virtual ~ReplayModel() = default;
   virtual int states() const = 0;        // <= kMaxStates
   virtual int time_index() const = 0;    // the state that holds time [s] (grip changes)

@@ -30,12 +30,33 @@ void predict_segment(const ReplayModel& model, const DiagData& d, const Segment&
   float x[ReplayModel::kMaxStates];
   VehicleState vs;
   const std::size_t k0 = s.start;
+  // Sensor faults: the true velocities behind a measurement, and the commands that acted over a
+  // state-stamped interval (shifted by the time offset; the interval average of the held commands).
+  const SensorFaults& sf = model.sensor;
+  const double inv_scale = 1.0 / sf.speed_scale;
+  auto true_vx = [&](std::size_t k) { return static_cast<float>(d.vx[k] * inv_scale); };
+  auto true_vy = [&](std::size_t k) { return static_cast<float>(d.vy[k] * inv_scale); };
+  auto true_r = [&](std::size_t k) { return static_cast<float>(d.r[k] - sf.gyro_bias_radps); };
+  const double shift_rows = sf.time_offset_s / d.dt_s;
+  auto command_over = [&](std::size_t k, float* u) {
+    if (shift_rows == 0.0) {
+      u[0] = static_cast<float>(d.steer_over(k));
+      u[1] = static_cast<float>(d.throttle_over(k));
+      return;
+    }
+    const double pos = static_cast<double>(k) - shift_rows;
+    const double lo = std::floor(pos), w = pos - lo;
+    const auto at = [&](double i) { return static_cast<std::size_t>(std::clamp(i, 0.0, static_cast<double>(d.rows() - 1))); };
+    const std::size_t i0 = at(lo), i1 = at(lo + 1);
+    u[0] = static_cast<float>((1 - w) * d.steer_over(i0) + w * d.steer_over(i1));
+    u[1] = static_cast<float>((1 - w) * d.throttle_over(i0) + w * d.throttle_over(i1));
+  };
   vs.x_m = static_cast<float>(d.x[k0]);
   vs.y_m = static_cast<float>(d.y[k0]);
   vs.yaw_rad = static_cast<float>(d.yaw[k0]);
-  vs.vx_mps = static_cast<float>(d.vx[k0]);
-  vs.vy_mps = static_cast<float>(d.vy[k0]);
-  vs.yaw_rate_radps = static_cast<float>(d.r[k0]);
+  vs.vx_mps = true_vx(k0);
+  vs.vy_mps = true_vy(k0);
+  vs.yaw_rate_radps = true_r(k0);
   const bool has_roll = !d.roll.empty() && std::isfinite(d.roll[k0]);
   if (has_roll) vs.roll_rad = static_cast<float>(d.roll[k0]);
   model.init_state(vs, x);
@@ -47,7 +68,9 @@ void predict_segment(const ReplayModel& model, const DiagData& d, const Segment&
   std::size_t h = k0;
   const int prime_rows = static_cast<int>(std::lround(o.prime_s / d.dt_s));
   for (int i = 0; i < prime_rows && h > 0 && d.piece[h - 1] == d.piece[k0]; ++i) --h;
-  model.set_actuators(x, static_cast<float>(d.steer_over(h)), static_cast<float>(d.throttle_over(h)));
+  float u[2];
+  command_over(h, u);
+  model.set_actuators(x, u[0], u[1]);
   // Velocities: a constant-gain observer (blend of the model's value and the measurement) once
   // the full model runs, which takes sensor noise off the start state; the rest measured.
   bool observing = false;
@@ -56,19 +79,17 @@ void predict_segment(const ReplayModel& model, const DiagData& d, const Segment&
     x[state::kY] = static_cast<float>(d.y[k]);
     x[state::kYaw] = static_cast<float>(d.yaw[k]);
     const float g = observing ? static_cast<float>(o.observer_gain) : 1.f;
-    x[state::kVx] += g * (static_cast<float>(d.vx[k]) - x[state::kVx]);
-    x[state::kVy] += g * (static_cast<float>(d.vy[k]) - x[state::kVy]);
-    x[state::kYawRate] += g * (static_cast<float>(d.r[k]) - x[state::kYawRate]);
+    x[state::kVx] += g * (true_vx(k) - x[state::kVx]);
+    x[state::kVy] += g * (true_vy(k) - x[state::kVy]);
+    x[state::kYawRate] += g * (true_r(k) - x[state::kYawRate]);
     if (has_roll && std::isfinite(d.roll[k])) x[state::kRoll] += g * (static_cast<float>(d.roll[k]) - x[state::kRoll]);
     x[time_state] = static_cast<float>(d.t[k]);
   };
-  float u[2];
   for (std::size_t k = h; k < k0; ++k) {
     force_measured(k);
     const double dt = d.t[k + 1] - d.t[k];
     const int n = std::max(1, static_cast<int>(std::lround(dt / o.substep_s)));
-    u[0] = static_cast<float>(d.steer_over(k));
-    u[1] = static_cast<float>(d.throttle_over(k));
+    command_over(k, u);
     if (static_cast<double>(k0 - k) * d.dt_s > o.wheel_prime_s) {  // actuators only
       model.advance_actuators(x, u[0], u[1], static_cast<float>(dt));
       continue;
@@ -83,14 +104,13 @@ void predict_segment(const ReplayModel& model, const DiagData& d, const Segment&
     const double dt = d.t[k + 1] - d.t[k];
     const int n = std::max(1, static_cast<int>(std::lround(dt / o.substep_s)));
     const float h_s = static_cast<float>(dt / n);
-    u[0] = static_cast<float>(d.steer_over(k));
-    u[1] = static_cast<float>(d.throttle_over(k));
+    command_over(k, u);
     for (int j = 0; j < n; ++j)
       model.step(x, u[0], u[1], h_s);
     double* o5 = out + static_cast<std::ptrdiff_t>(i) * kPredStride;
-    o5[0] = x[state::kVx];
-    o5[1] = x[state::kVy];
-    o5[2] = x[state::kYawRate];
+    o5[0] = x[state::kVx] * sf.speed_scale;  // as the sensors would show them
+    o5[1] = x[state::kVy] * sf.speed_scale;
+    o5[2] = x[state::kYawRate] + sf.gyro_bias_radps;
     o5[3] = x[state::kX];
     o5[4] = x[state::kY];
   }

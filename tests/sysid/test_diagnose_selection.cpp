@@ -13,7 +13,10 @@
 #include "dynamics/corrected_model.hpp"
 #include "dynamics/with_effects.hpp"
 #include "sysid/diagnose/diagnose.hpp"
+#include "sysid/diagnose/identifiability.hpp"
 #include "sysid/diagnose/synth.hpp"
+#include "dynamics/single_track.hpp"
+#include <random>
 
 using namespace mppi;
 using namespace mppi::diagnose;
@@ -84,4 +87,87 @@ TEST_CASE("two hidden effects at once are both named; report and model file agre
   CHECK(std::filesystem::file_size(dir / "overlay.png") > 1000);
   CHECK(std::filesystem::file_size(dir / "residual_vs_regime.png") > 1000);
   std::filesystem::remove_all(dir);
+}
+
+namespace {
+
+// A straight-line drive written here, independent of the library's generators: the single-track
+// model with the steering held at zero and the throttle stepping between a few levels, logged
+// at 50 Hz with a little sensor noise.
+sim::Recording straight_line_drive(std::uint64_t seed, double duration_s) {
+  const SingleTrack car;
+  float x[SingleTrack::kNx];
+  VehicleState s0;
+  s0.vx_mps = 3.f;
+  car.init_state(s0, x);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const double levels[] = {0.2, 0.45, 0.1, 0.35};
+  sim::Recording rec;
+  rec.columns = {sim::kRecordingRequiredColumns.begin(), sim::kRecordingRequiredColumns.end()};
+  rec.data.assign(rec.columns.size(), {});
+  const int rows = static_cast<int>(duration_s / 0.02);
+  for (int k = 0; k < rows; ++k) {
+    const float throttle = static_cast<float>(levels[(k / 150) % 4]);
+    const double row[] = {0.02 * k, x[state::kX], x[state::kY], x[state::kYaw], x[state::kVx] + noise(rng),
+                          x[state::kVy] + noise(rng), x[state::kYawRate] + noise(rng), 0.0, throttle};
+    for (std::size_t c = 0; c < rec.columns.size(); ++c) rec.data[c].push_back(row[c]);
+    const float u[2] = {0.f, throttle};
+    for (int j = 0; j < 10; ++j) car.step<1>(Batch<SingleTrack::kNx, 1>{x}, ConstBatch<2, 1>{u}, 0.002f, nullptr);
+  }
+  return rec;
+}
+
+}  // namespace
+
+TEST_CASE("a straight-line recording cannot name steering or grip effects", "[diagnose]") {
+  const DiagData d = prepare(straight_line_drive(5, 40.0), "straight line");
+  DiagnoseOptions o;
+  o.plots = false;
+  const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track"), o);
+  CHECK(r.selection.selected.empty());
+  for (const auto& c : r.selection.candidates) {
+    INFO(c.id);
+    const Excitation needs = effect_spec(c.id).needs;
+    if (needs == Excitation::kSteer || needs == Excitation::kCornering) CHECK_FALSE(c.not_testable.empty());
+    if (needs == Excitation::kThrottle) CHECK(c.not_testable.empty());
+  }
+}
+
+TEST_CASE("a parameter at the end of its search range is a bound, not an estimate", "[diagnose]") {
+  const EffectSpec& tyres = effect_spec("tire_saturation");
+  EffectParams e;
+  e.tyre_stiffness_scale = 5.0;  // the upper end of its search range [0.2, 5]
+  CHECK_THAT(range_limit_shortfall(tyres, e), Catch::Contains("tyre_stiffness_scale") && Catch::Contains("upper"));
+  e.tyre_stiffness_scale = 3.0;
+  CHECK(range_limit_shortfall(tyres, e).empty());
+  // A rate limit's lower end is its default (no limit): not a bound of an estimate.
+  CHECK(range_limit_shortfall(effect_spec("steer_rate_limit"), EffectParams{}).empty());
+  e = {};
+  e.steer_slew_s = 3.0;
+  CHECK_FALSE(range_limit_shortfall(effect_spec("steer_rate_limit"), e).empty());
+}
+
+TEST_CASE("an effect that the held-out part contradicts is not named and no model is written", "[diagnose]") {
+  // A gyro bias in the first 70 % of the recording only: the training part shows it, the
+  // held-out part (the last 30 %) does not.
+  DiagData d = prepare(synthesize_open_loop({}, 8, 40.0), "bias that goes away");
+  const double t_end = d.t.back();
+  for (std::size_t k = 0; k < d.rows(); ++k)
+    if (d.t[k] < 0.7 * t_end) d.r[k] += 0.08;
+  const auto out = std::filesystem::temp_directory_path() / "mppi_diag_unreliable";
+  std::filesystem::remove_all(out);
+  std::filesystem::create_directories(out);
+  std::ofstream(out / "corrected_model.yaml") << "stale\n";
+  DiagnoseOptions o;
+  o.out_dir = out.string();
+  o.plots = false;
+  const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track"), o);
+  CHECK_FALSE(r.selection.reliable);
+  CHECK(r.selection.selected.empty());
+  CHECK_THAT(r.selection.verdict, Catch::Contains("no reliable correction"));
+  CHECK_FALSE(std::filesystem::exists(out / "corrected_model.yaml"));
+  bool bias_suspected = false;
+  for (const auto& s : r.selection.suspected) bias_suspected |= s.id == "gyro_bias";
+  CHECK(bias_suspected);
 }

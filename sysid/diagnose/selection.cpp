@@ -1,0 +1,351 @@
+// Which effects to name: greedy forward selection judged on later data (forward validation),
+// checked for identifiability (excitation, parameters at their search range's end), for
+// stability (block-bootstrap refits) and, at the end, on the held-out part of the recording.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <random>
+
+#include "mppi/error.hpp"
+#include "sysid/diagnose/fit.hpp"
+#include "sysid/diagnose/identifiability.hpp"
+
+namespace mppi::diagnose {
+namespace {
+
+double heldout_1s_normalized_rmse(const ReplayModel& m, const DiagData& d, const std::vector<char>& mask,
+                                  const ReplayOptions& o) {
+  return horizon_metrics(m, d, mask, {1.0}, 5, o)[0].normalized_rmse;
+}
+
+struct CandidateFit {
+  int index = -1;  // into the candidate list
+  FitResult fit;
+  double val_cost = 0, improvement = 0, bic = 0;
+  bool passes = false;
+};
+
+struct GreedyResult {
+  std::vector<int> chosen;  // candidate indices in the order chosen
+  EffectParams effects;
+  std::vector<CandidateFit> first_round;  // every candidate of the pool, alone on the nominal
+  std::vector<std::pair<int, std::string>> at_limit;  // passed, but a parameter is a bound
+  std::vector<int> passed;  // every candidate that passed in some round
+};
+
+// Greedy forward selection over `pool` (indices into cands): each round fits every remaining
+// candidate on top of what is chosen and takes the one with the lowest BIC among those that
+// lower the validation cost enough and the BIC too, with identified parameters; a time-indexed change
+// gives way to a state-dependent candidate that explains most of the same.
+GreedyResult greedy(const FitProblem& fit, const FitProblem& val, const std::vector<const EffectSpec*>& cands,
+                    const std::vector<int>& pool, const SelectionOptions& opt, double n_eff,
+                    std::vector<std::string>* log) {
+  GreedyResult out;
+  EffectParams base;
+  double base_fit = mean_cost(fit, base), base_val = mean_cost(val, base);
+  std::vector<bool> taken(cands.size(), false);
+  char line[512];
+  for (int round = 1; round <= opt.max_effects; ++round) {
+    std::vector<CandidateFit> tried;
+    for (int i : pool) {
+      if (taken[static_cast<std::size_t>(i)]) continue;
+      CandidateFit c;
+      c.index = i;
+      c.fit = fit_effect(fit, base, *cands[static_cast<std::size_t>(i)]);
+      c.val_cost = mean_cost(val, c.fit.effects);
+      const double k = static_cast<double>(cands[static_cast<std::size_t>(i)]->params.size());
+      c.bic = n_eff * std::log(c.fit.cost / base_fit) + k * std::log(n_eff);
+      c.improvement = 1.0 - c.val_cost / base_val;
+      c.passes = c.improvement >= opt.min_val_improvement && c.bic <= -opt.min_bic_drop && c.val_cost < base_val;
+      if (log) {
+        std::snprintf(line, sizeof line, "round %d: %-20s validation %+6.1f %%, dBIC %+9.1f%s", round,
+                      cands[static_cast<std::size_t>(i)]->id.c_str(), 100 * c.improvement, c.bic,
+                      c.passes ? "  passes" : "");
+        log->push_back(line);
+      }
+      if (c.passes && std::find(out.passed.begin(), out.passed.end(), i) == out.passed.end()) out.passed.push_back(i);
+      tried.push_back(std::move(c));
+    }
+    if (round == 1) out.first_round = tried;
+    std::vector<const CandidateFit*> order;
+    for (const auto& c : tried)
+      if (c.passes) order.push_back(&c);
+    // Among those that hold on later data, the information criterion on the fit part ranks: an
+    // effect with fewer parameters that fits as well wins (c v^2 over F0 + b v on a speed range).
+    std::sort(order.begin(), order.end(), [](const CandidateFit* a, const CandidateFit* b) { return a->bic < b->bic; });
+    const CandidateFit* pick = nullptr;
+    for (const CandidateFit* c : order) {
+      const EffectSpec& spec = *cands[static_cast<std::size_t>(c->index)];
+      const std::string limit = range_limit_shortfall(spec, c->fit.effects, opt.range_limit_margin);
+      if (!limit.empty()) {
+        out.at_limit.emplace_back(c->index, limit);
+        if (log) log->push_back("round " + std::to_string(round) + ": " + spec.id + " not identified: " + limit);
+        continue;
+      }
+      if (spec.time_grid) {
+        // A change "from time t on" is also what a place or a state that the car reaches later
+        // looks like; the state-dependent explanation wins when it does nearly as well.
+        const CandidateFit* rival = nullptr;
+        for (const auto& o : tried) {
+          const EffectSpec& os = *cands[static_cast<std::size_t>(o.index)];
+          if (os.time_grid || os.hook != EffectHook::kChassis) continue;
+          if (o.improvement >= opt.time_change_dominance * c->improvement && (!rival || o.improvement > rival->improvement))
+            rival = &o;
+        }
+        if (rival) {
+          if (log)
+            log->push_back("round " + std::to_string(round) + ": " + spec.id + " set aside: " +
+                           cands[static_cast<std::size_t>(rival->index)]->id + " explains it as well without a clock");
+          continue;
+        }
+      }
+      pick = c;
+      break;
+    }
+    if (!pick) {
+      if (log) log->push_back("round " + std::to_string(round) + ": no candidate passes; stop");
+      break;
+    }
+    taken[static_cast<std::size_t>(pick->index)] = true;
+    out.chosen.push_back(pick->index);
+    base = pick->fit.effects;
+    base_fit = pick->fit.cost;
+    base_val = pick->val_cost;
+    if (log) {
+      std::snprintf(line, sizeof line, "round %d: selected %s (validation %+.1f %%, dBIC %.1f)", round,
+                    cands[static_cast<std::size_t>(pick->index)]->id.c_str(), 100 * pick->improvement, pick->bic);
+      log->push_back(line);
+    }
+  }
+  out.effects = base;
+  return out;
+}
+
+// Block bootstrap of segments: blocks of consecutive segments drawn with replacement.
+std::vector<Segment> resample_blocks(const std::vector<Segment>& segs, int block, std::mt19937_64& rng) {
+  const int n = static_cast<int>(segs.size());
+  const int blocks = std::max(1, (n + block - 1) / block);
+  std::uniform_int_distribution<int> pick(0, blocks - 1);
+  std::vector<Segment> out;
+  for (int b = 0; b < blocks; ++b) {
+    const int first = pick(rng) * block;
+    for (int i = first; i < std::min(n, first + block); ++i) out.push_back(segs[static_cast<std::size_t>(i)]);
+  }
+  return out;
+}
+
+// Effect parameters of `ids` copied from `from`, everything else at its default.
+EffectParams only(const std::vector<std::string>& ids, const EffectParams& from) {
+  EffectParams e;
+  for (const auto& id : ids)
+    for (const EffectParamSpec& p : effect_spec(id).params) e.*(p.member) = from.*(p.member);
+  return e;
+}
+
+}  // namespace
+
+Selection select_effects(const DiagData& d, const ModelFamily& nominal, const std::vector<char>& train_mask,
+                         const std::vector<char>& heldout_mask, const SelectionOptions& opt,
+                         const ReplayOptions& replay) {
+  Selection sel;
+  const int len = std::max(2, static_cast<int>(std::lround(opt.fit_horizon_s / d.dt_s)));
+  const auto segs = make_segments(d, train_mask, len, len);
+  if (segs.size() < 6)
+    throw Error(d.source + ": too little continuous training data: " + std::to_string(segs.size()) +
+                " segments of " + std::to_string(opt.fit_horizon_s) + " s (need >= 6)");
+  FitProblem all, fit, val;
+  all.data = fit.data = val.data = &d;
+  all.family = fit.family = val.family = &nominal;
+  all.replay = fit.replay = val.replay = replay;
+  all.scale = fit.scale = val.scale = channel_scales(d, train_mask);
+  all.segments = segs;
+  // Forward validation: segments are in time order; the last part judges the earlier.
+  const std::size_t n_val = std::clamp<std::size_t>(
+      static_cast<std::size_t>(std::lround(opt.validation_fraction * static_cast<double>(segs.size()))), 3,
+      segs.size() - 3);
+  fit.segments.assign(segs.begin(), segs.end() - static_cast<std::ptrdiff_t>(n_val));
+  val.segments.assign(segs.end() - static_cast<std::ptrdiff_t>(n_val), segs.end());
+  const double n_fit = static_cast<double>(fit.segments.size() * static_cast<std::size_t>(len) * kChannels);
+  const double n_eff = n_fit / opt.samples_per_independent;
+  char line[512];
+  std::snprintf(line, sizeof line, "fit on %zu segments of %.2f s up to t = %.1f s, validated on the %zu after",
+                fit.segments.size(), len * d.dt_s, d.t[fit.segments.back().start], val.segments.size());
+  sel.log.push_back(line);
+
+  // Candidates, and which of them this recording can identify at all.
+  std::vector<const EffectSpec*> cands;
+  if (opt.candidates.empty()) {
+    for (const auto& e : effect_library())
+      if (nominal.supports(e.id)) cands.push_back(&e);
+  } else {
+    for (const auto& id : opt.candidates) {
+      if (!nominal.supports(id))
+        throw Error("effect '" + id + "' needs a tyre model; the nominal " + nominal.name() + " has none");
+      cands.push_back(&effect_spec(id));
+    }
+  }
+  const ExcitationLevels excitation = measure_excitation(d, train_mask);
+  sel.candidates.resize(cands.size());
+  std::vector<int> pool;
+  for (std::size_t i = 0; i < cands.size(); ++i) {
+    sel.candidates[i].id = cands[i]->id;
+    sel.candidates[i].not_testable = excitation_shortfall(cands[i]->needs, excitation);
+    if (sel.candidates[i].not_testable.empty())
+      pool.push_back(static_cast<int>(i));
+    else
+      sel.log.push_back(cands[i]->id + " not testable: " + sel.candidates[i].not_testable);
+  }
+
+  const auto nominal_model = nominal.make({});
+  const double held_nominal = heldout_1s_normalized_rmse(*nominal_model, d, heldout_mask, replay);
+  const GreedyResult main = greedy(fit, val, cands, pool, opt, n_eff, &sel.log);
+  for (const CandidateFit& c : main.first_round) {
+    CandidateReport& r = sel.candidates[static_cast<std::size_t>(c.index)];
+    r.params = c.fit.params;
+    r.val_improvement = c.improvement;
+    r.bic_delta = c.bic;
+    const auto m = make_member_or_null(nominal, c.fit.effects);
+    r.heldout_improvement = m && held_nominal > 0 ? 1.0 - heldout_1s_normalized_rmse(*m, d, heldout_mask, replay) / held_nominal : 0.0;
+  }
+  auto suspect = [&](int index, const std::string& reason, const EffectParams& e) {
+    const EffectSpec& spec = *cands[static_cast<std::size_t>(index)];
+    for (const auto& s : sel.suspected)
+      if (s.id == spec.id) return;
+    SuspectedEffect s{spec.id, reason, {}};
+    for (const EffectParamSpec& p : spec.params) s.params.push_back({p.name, p.unit, e.*(p.member), 0.0});
+    sel.suspected.push_back(std::move(s));
+  };
+  for (const auto& [index, reason] : main.at_limit) {
+    const bool chosen_later = std::find(main.chosen.begin(), main.chosen.end(), index) != main.chosen.end();
+    if (!chosen_later) {
+      EffectParams e;
+      for (const CandidateFit& c : main.first_round)
+        if (c.index == index) e = c.fit.effects;
+      suspect(index, "not identifiable from this recording: " + reason, e);
+    }
+  }
+
+  // Stability selection over what passed: refits on block-bootstrap resamples of the fit part.
+  std::vector<int> stable_pool;
+  for (int i : main.passed)
+    if (std::none_of(main.at_limit.begin(), main.at_limit.end(), [&](const auto& a) { return a.first == i; }) ||
+        std::find(main.chosen.begin(), main.chosen.end(), i) != main.chosen.end())
+      stable_pool.push_back(i);
+  std::vector<int> inclusion(cands.size(), 0);
+  if (!main.chosen.empty() && opt.stability_resamples > 0) {
+    std::mt19937_64 rng(opt.seed * 0x9E3779B97F4A7C15ull + 17);
+    const int block = std::max(2, static_cast<int>(std::lround(2.0 / (len * d.dt_s))));  // about 2 s
+    for (int b = 0; b < opt.stability_resamples; ++b) {
+      FitProblem fit_b = fit;
+      fit_b.segments = resample_blocks(fit.segments, block, rng);
+      const GreedyResult g = greedy(fit_b, val, cands, stable_pool, opt, n_eff, nullptr);
+      for (int i : g.chosen) ++inclusion[static_cast<std::size_t>(i)];
+    }
+    for (int i : stable_pool) {
+      CandidateReport& r = sel.candidates[static_cast<std::size_t>(i)];
+      r.inclusion_frequency = static_cast<double>(inclusion[static_cast<std::size_t>(i)]) / opt.stability_resamples;
+      std::snprintf(line, sizeof line, "stability: %s chosen in %d of %d resamples", r.id.c_str(),
+                    inclusion[static_cast<std::size_t>(i)], opt.stability_resamples);
+      sel.log.push_back(line);
+    }
+  }
+  std::vector<std::string> named;
+  for (int i : main.chosen) {
+    const CandidateReport& r = sel.candidates[static_cast<std::size_t>(i)];
+    if (opt.stability_resamples > 0 && r.inclusion_frequency < opt.min_inclusion_frequency) {
+      std::snprintf(line, sizeof line, "unstable: chosen in %.0f %% of the resamples of the data (< %.0f %%)",
+                    100 * r.inclusion_frequency, 100 * opt.min_inclusion_frequency);
+      suspect(i, line, main.effects);
+      continue;
+    }
+    named.push_back(r.id);
+  }
+
+  // Joint refit of the named effects on all training segments; an effect whose parameter ends at
+  // a bound there is not identified either.
+  EffectParams start = only(named, main.effects);
+  for (int pass = 0; pass < 3 && !named.empty(); ++pass) {
+    std::vector<ParamSpec> free;
+    std::vector<ParamEstimate> fixed_times;
+    for (const auto& id : named) {
+      const EffectSpec& s = effect_spec(id);
+      for (std::size_t j = 0; j < s.params.size(); ++j) {
+        if (s.time_grid && j == 0) {
+          fixed_times.push_back({s.params[0].name, s.params[0].unit, start.*(s.params[0].member), 0.0});
+          for (const auto& c : sel.candidates)
+            if (c.id == id && !c.params.empty()) fixed_times.back().stddev = c.params[0].stddev;
+          continue;
+        }
+        free.push_back(s.params[j]);
+      }
+    }
+    const FitResult joint = fit_params(all, start, free);
+    std::vector<std::string> keep;
+    for (const auto& id : named) {
+      const std::string limit = range_limit_shortfall(effect_spec(id), joint.effects, opt.range_limit_margin);
+      if (limit.empty()) {
+        keep.push_back(id);
+      } else {
+        for (std::size_t i = 0; i < cands.size(); ++i)
+          if (cands[i]->id == id) suspect(static_cast<int>(i), "not identifiable from this recording: " + limit, joint.effects);
+        sel.log.push_back("joint refit: " + id + " not identified: " + limit);
+      }
+    }
+    if (keep.size() == named.size()) {
+      sel.final_effects = joint.effects;
+      sel.final_params = fixed_times;
+      sel.final_params.insert(sel.final_params.end(), joint.params.begin(), joint.params.end());
+      break;
+    }
+    named = keep;
+    start = only(named, joint.effects);
+    sel.final_effects = {};
+    sel.final_params.clear();
+  }
+  sel.selected = named;
+  for (auto& c : sel.candidates) {
+    c.selected = std::find(named.begin(), named.end(), c.id) != named.end();
+    if (c.selected)
+      for (std::size_t k = 0; k < main.chosen.size(); ++k)
+        if (cands[static_cast<std::size_t>(main.chosen[k])]->id == c.id) c.round_selected = static_cast<int>(k) + 1;
+  }
+
+  // The held-out part decides whether the correction is trusted.
+  sel.heldout_nominal = held_nominal;
+  sel.heldout_corrected = held_nominal;
+  if (!named.empty()) {
+    const auto corrected = make_member_or_null(nominal, sel.final_effects);
+    sel.heldout_corrected = corrected ? heldout_1s_normalized_rmse(*corrected, d, heldout_mask, replay)
+                                      : std::numeric_limits<double>::infinity();
+    const int held_starts = static_cast<int>(make_segments(d, heldout_mask, std::max(1, static_cast<int>(std::lround(1.0 / d.dt_s))), 5).size());
+    if (held_starts > 0 && !(sel.heldout_corrected < held_nominal)) {
+      std::snprintf(line, sizeof line, "the corrected model is not better on the held-out part (1-s normalised RMSE %.4f -> %.4f)",
+                    held_nominal, sel.heldout_corrected);
+      for (const auto& id : named)
+        for (std::size_t i = 0; i < cands.size(); ++i)
+          if (cands[i]->id == id) suspect(static_cast<int>(i), line, sel.final_effects);
+      for (auto& c : sel.candidates) c.selected = false;
+      sel.reliable = false;
+      sel.selected.clear();
+      sel.final_effects = {};
+      sel.final_params.clear();
+      sel.verdict = std::string("no reliable correction: ") + line;
+      sel.log.push_back(sel.verdict);
+      return sel;
+    }
+  }
+  if (sel.selected.empty())
+    sel.verdict = sel.suspected.empty() ? "nothing named: the nominal model stands"
+                                        : "nothing named; suspected effects listed, not identifiable from this recording";
+  else
+    sel.verdict = "named: " + [&] {
+      std::string s;
+      for (const auto& id : sel.selected) s += (s.empty() ? "" : ", ") + id;
+      return s;
+    }();
+  sel.log.push_back(sel.verdict);
+  return sel;
+}
+
+}  // namespace mppi::diagnose
