@@ -6,7 +6,7 @@ set -euo pipefail
 MPPI_DEBIAN_PACKAGES=(
   build-essential cmake pkg-config git
   libeigen3-dev libtbb-dev libzip-dev libyaml-cpp-dev libopencv-dev librandom123-dev
-  nlohmann-json3-dev catch2 libbenchmark-dev
+  nlohmann-json3-dev catch2 libbenchmark-dev libcli11-dev
   python3 python3-numpy python3-dev python3-pytest pybind11-dev
   mesa-vulkan-drivers libvulkan-dev glslang-tools spirv-tools
 )

@@ -1,0 +1,65 @@
+#include "cli/sim_command_line.hpp"
+
+#include "cli/app.hpp"
+#include "cli/options.hpp"
+
+namespace mppi::cli {
+
+sim::ClosedLoopConfig SimCommandLine::defaults() {
+  sim::ClosedLoopConfig c;
+  c.out_dir = "out/sim";
+  c.backend = BackendChoice::kAuto;
+  return c;
+}
+
+void add_sim_options(CLI::App& app, SimCommandLine& cl) {
+  configure(app);
+  sim::ClosedLoopConfig& c = cl.config;
+  ControllerOptions& mppi = c.controller;
+  add_track_option(app, c.track);
+  app.add_flag("--clockwise", c.clockwise, "drive clockwise (default counter-clockwise)");
+  add_model_option(app, "--model", c.model,
+                   "controller model: a registered model, or corrected (a nominal model + effects from mppi-fit "
+                   "diagnose, in --model-params)",
+                   {}, {"corrected"});
+  add_model_option(app, "--plant", c.plant, "simulated car: a registered model, or corrected", {}, {"corrected"});
+  app.add_flag("--list-models", cl.list_models, "every model with its data file, states and parameters, and exit")
+      ->configurable(false);
+  app.add_option("--speed", c.target_speed_mps, "target speed [m/s]")->type_name("MPS");
+  app.add_option("--laps", c.laps, "laps to drive")->type_name("N");
+  app.add_option("--max-time", c.max_time_s, "stop after S simulated seconds (0: from the laps)")->type_name("S");
+  app.add_option("--samples", mppi.num_samples, "MPPI samples per step")->type_name("K");
+  app.add_option("--horizon", mppi.horizon, "MPPI time steps")->type_name("T");
+  app.add_option("--iterations", mppi.iterations, "MPPI iterations per step")->type_name("N");
+  // Read as a double and rounded once to float, as the controller options hold it.
+  app.add_option_function<double>(
+         "--lambda", [&mppi](double v) { mppi.lambda = static_cast<float>(v); }, "MPPI temperature")
+      ->type_name("L")
+      ->default_str(CLI::detail::to_string(mppi.lambda));
+  app.add_option("--smoothing", mppi.smoothing_window, "Savitzky-Golay window over the plan, 0 = off")
+      ->type_name("W");
+  add_seed_option(app, mppi.seed);
+  add_threads_option(app, mppi.num_threads);
+  add_backend_option(app, c.backend);
+  app.add_option("--cost-config", c.cost_params_yaml, "AutoRally cost weights (YAML; default data/config)")
+      ->type_name("FILE");
+  app.add_option("--plant-params", c.plant_params_yaml,
+                 "the plant's data file (YAML parameters, or a corrected-model file; keys: --list-models)")
+      ->type_name("FILE");
+  app.add_option("--model-params", c.model_params_yaml, "the controller model's data file (the same kinds)")
+      ->type_name("FILE");
+  app.add_option("--network", c.network_npz, "weights (.npz) of a learned model, when no --*-params file is given")
+      ->type_name("FILE");
+  add_out_option(app, c.out_dir, "write DIR/log.csv, DIR/track.png, DIR/summary.json");
+  app.add_flag("--json", cl.print_json, "print summary.json to stdout");
+  app.add_flag("--quiet", cl.quiet, "no progress lines");
+  add_data_dir_option(app, cl.data_dir);
+  cl.run_file.add_options(app);
+}
+
+void finish_sim_options(CLI::App& app, SimCommandLine& cl) {
+  cl.run_file.apply(app);
+  cl.config.progress = !cl.quiet;
+}
+
+}  // namespace mppi::cli
