@@ -1,31 +1,33 @@
 // mppi-fit: parameter estimation and sim-vs-real tools; dispatches to a subcommand.
 #include <cstdio>
-#include <cstring>
 
+#include "cli/app.hpp"
 #include "mppi_fit_commands.hpp"
 
-namespace {
-
-const char* kUsage = R"(usage: mppi-fit <command> [options]   (mppi-fit <command> --help for its options)
-commands:
-  estimate   estimate model parameters from a recording (UKF, joint UKF, ALM-UKF)
-  convert    convert a shipped real-data recording into the project's recording format
-  diagnose   compare a recording against the simulator's prediction (sim vs real)
-  protocol   simulate the paper's estimation manoeuvres on the full-vehicle plant
-)";
-
-}  // namespace
+int FitCommands::run() const {
+  for (auto it = runs_.rbegin(); it != runs_.rend(); ++it) {
+    if (!it->first->parsed()) continue;
+    try {
+      return it->second();
+    } catch (const CLI::ParseError& e) {
+      std::string name;
+      for (const CLI::App* a = it->first; a != nullptr; a = a->get_parent()) name = a->get_name() + (name.empty() ? "" : " ") + name;
+      std::fprintf(stderr, "%s: %s\nRun with --help for more information.\n", name.c_str(), e.what());
+      return mppi::cli::kUsageExit;
+    }
+  }
+  return mppi::cli::kUsageExit;  // not reached: a command is required
+}
 
 int main(int argc, char** argv) {
-  if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0) {
-    std::fputs(kUsage, argc < 2 ? stderr : stdout);
-    return argc < 2 ? 2 : 0;
-  }
-  const char* cmd = argv[1];
-  if (std::strcmp(cmd, "estimate") == 0) return mppi_fit_estimate(argc - 1, argv + 1);
-  if (std::strcmp(cmd, "convert") == 0) return mppi_fit_convert(argc - 1, argv + 1);
-  if (std::strcmp(cmd, "diagnose") == 0) return mppi_fit_diagnose(argc - 1, argv + 1);
-  if (std::strcmp(cmd, "protocol") == 0) return mppi_fit_protocol(argc - 1, argv + 1);
-  std::fprintf(stderr, "mppi-fit: unknown command '%s'\n%s", cmd, kUsage);
-  return 2;
+  CLI::App app{"Parameter estimation and sim-vs-real tools (mppi-fit <command> --help for its options).", "mppi-fit"};
+  mppi::cli::configure(app);
+  app.require_subcommand(1);
+  FitCommands commands;
+  add_estimate_command(app, commands);
+  add_convert_command(app, commands);
+  add_diagnose_command(app, commands);
+  add_protocol_command(app, commands);
+  if (const int rc = mppi::cli::parse(app, argc, argv); rc >= 0) return rc;
+  return commands.run();
 }

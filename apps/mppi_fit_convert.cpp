@@ -1,9 +1,11 @@
 // mppi-fit convert: a shipped real recording (DART JetRacer, ETH RC car) -> the project's
 // recording format (docs/RECORDING_FORMAT.md). Conventions: sysid/real_data.hpp.
 #include <cstdio>
-#include <cstring>
+#include <memory>
 #include <string>
 
+#include "cli/app.hpp"
+#include "cli/options.hpp"
 #include "mppi/error.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"
@@ -11,57 +13,28 @@
 
 namespace {
 
-const char* kConvertUsage = R"(usage: mppi-fit convert INPUT [options]
-  INPUT                a raw CSV, or ARCHIVE.zip:MEMBER.csv (e.g. the shipped
-                       data/real/dart_jetracer.zip:car_1_Datarecording_09_16_2024_10_27_02.csv);
-                       a name starting with "real/" is looked up in the data folder
-  --out FILE           output recording (default: stdout summary only, nothing written)
-  --source NAME        auto | dart | eth                       (auto: from the header)
-  --smoothing N        DART: samples each side of the Vicon pose fit (10 = +-0.1 s)
-  --list ARCHIVE       list the members of a zip archive and exit
-)";
+struct ConvertArgs {
+  std::string input, out, source = "auto", list_archive;
+  mppi::sysid::RealConvertSettings settings;
+};
 
-}  // namespace
-
-int mppi_fit_convert(int argc, char** argv) {
-  std::string input, out;
-  mppi::sysid::RealConvertSettings s;
+int run_convert(ConvertArgs& args) {
+  mppi::sysid::RealConvertSettings s = args.settings;
+  if (args.source == "dart") s.source = mppi::sysid::RealSource::kDartJetracer;
+  else if (args.source == "eth") s.source = mppi::sysid::RealSource::kEthRccar;
+  else s.source = mppi::sysid::RealSource::kAuto;
+  std::string input = args.input;
+  const std::string& out = args.out;
   try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string a = argv[i];
-      auto value = [&]() -> std::string {
-        if (i + 1 >= argc) throw mppi::Error(a + " expects a value");
-        return argv[++i];
-      };
-      if (a == "--help" || a == "-h") {
-        std::fputs(kConvertUsage, stdout);
-        return 0;
-      } else if (a == "--out") {
-        out = value();
-      } else if (a == "--source") {
-        const std::string v = value();
-        if (v == "auto") s.source = mppi::sysid::RealSource::kAuto;
-        else if (v == "dart") s.source = mppi::sysid::RealSource::kDartJetracer;
-        else if (v == "eth") s.source = mppi::sysid::RealSource::kEthRccar;
-        else throw mppi::Error("--source expects auto, dart or eth, got '" + v + "'");
-      } else if (a == "--smoothing") {
-        s.smoothing_half_window = std::stoi(value());
-      } else if (a == "--list") {
-        for (const auto& m : mppi::sysid::zip_members(value())) std::printf("%s\n", m.c_str());
-        return 0;
-      } else if (!a.empty() && a[0] == '-') {
-        throw mppi::Error("unknown option " + a);
-      } else if (input.empty()) {
-        input = a;
-      } else {
-        throw mppi::Error("more than one input given");
-      }
+    if (!args.list_archive.empty()) {
+      for (const auto& m : mppi::sysid::zip_members(args.list_archive)) std::printf("%s\n", m.c_str());
+      return 0;
     }
-    if (input.empty()) throw mppi::Error("no input given");
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "mppi-fit convert: %s\n%s", e.what(), kConvertUsage);
+    std::fprintf(stderr, "mppi-fit convert: %s\n", e.what());
     return 2;
   }
+  if (input.empty()) throw mppi::cli::usage_error("INPUT", "no input given");
   try {
     if (input.rfind("real/", 0) == 0) {
       const std::size_t z = input.find(".zip:");
@@ -81,4 +54,27 @@ int mppi_fit_convert(int argc, char** argv) {
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+void add_convert_command(CLI::App& fit, FitCommands& commands) {
+  auto args = std::make_shared<ConvertArgs>();
+  CLI::App* cmd =
+      fit.add_subcommand("convert", "convert a shipped real-data recording into the project's recording format");
+  cmd->add_option("input", args->input,
+                  "a raw CSV, or ARCHIVE.zip:MEMBER.csv (e.g. the shipped "
+                  "data/real/dart_jetracer.zip:car_1_Datarecording_09_16_2024_10_27_02.csv); a name starting with "
+                  "\"real/\" is looked up in the data folder")
+      ->type_name("INPUT");
+  cmd->add_option("--out", args->out, "output recording (default: stdout summary only, nothing written)")
+      ->type_name("FILE");
+  cmd->add_option("--source", args->source, "auto | dart | eth (auto: from the header)")
+      ->type_name("NAME")
+      ->check(CLI::IsMember({"auto", "dart", "eth"}).description(""));
+  cmd->add_option("--smoothing", args->settings.smoothing_half_window,
+                  "DART: samples each side of the Vicon pose fit (10 = +-0.1 s)")
+      ->type_name("N");
+  cmd->add_option("--list", args->list_archive, "list the members of a zip archive and exit")->type_name("ARCHIVE");
+  commands.add(cmd, [args] { return run_convert(*args); });
 }

@@ -10,10 +10,15 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "cli/app.hpp"
+#include "cli/options.hpp"
+#include "dynamics/corrected_model.hpp"
+#include "dynamics/effects.hpp"
 #include "mppi/error.hpp"
 #include "dynamics/model_registry.hpp"
 #include "mppi_fit_commands.hpp"
@@ -28,88 +33,61 @@ namespace {
 using namespace mppi;
 using namespace mppi::diagnose;
 
-const char* kUsage = R"(usage:
-  mppi-fit diagnose --log FILE [options]         locate, name, model, show (report in --out)
-    --log FILE          recording (docs/RECORDING_FORMAT.md)
-    --model NAME        nominal model: single-track | double-track | full-vehicle  (single-track)
-    --params FILE       nominal parameters: that model's YAML or a corrected-model file
-                        (default: the library defaults, e.g. data/config/autorally_single_track.yaml)
-    --log may also be a real recording (DART / ETH CSV, or ARCHIVE.zip:MEMBER.csv), converted
-                        on the fly (sysid/real_data.hpp)
-    --holdout H         held-out fraction at the end (0.3) or time range T0:T1 [s]
-    --validate FILE     fit on all of --log, judge on this other recording (replaces --holdout)
-    --effects A,B,...   candidate ids (default: all)
-    --max-effects N     at most N effects named                              (3)
-    --min-improvement F validation-cost reduction an effect must give        (0.03)
-    --min-bic-drop B    and BIC decrease                                     (2)
-    --out DIR           report.json, report.md, PNG plots, corrected_model.yaml (out/diagnose)
-    --no-plots          skip the PNG plots
-  mppi-fit diagnose synth --out FILE.csv [--effect key=value,...] [--seed N] [--duration S]
-                          [--speed-range MIN:MAX | --speed V] [--samples K] [--track NAME]
-                          [--noise-scale F] [--nominal single-track|double-track|full-vehicle]
-                          (default: the target speed changes every 2-6 s, uniform in 3:8 m/s;
-                          --speed V holds it constant)
-  mppi-fit diagnose sweep [--seeds N] [--sizes small,large] [--effects A,B,...] [--clean N]
-                          [--duration S] [--speed-range MIN:MAX | --speed V] [--min-bic-drop B]
-                          [--nominal MODEL]  (truth base and diagnosed nominal; single-track)
-                          [--out DIR]   (seeds 3, clean 4; recordings already in DIR are reused)
-  mppi-fit diagnose loop --truth key=value,... | --case ID:small|large  --model-params FILE [--laps N] [--speed V]
-                         [--samples K] [--seed N | --seeds N] [--nominal MODEL] [--out DIR]
-                         (--seeds N: seeds 1..N and a mean +- sd summary)
-Effect ids: aero_drag rolling_resistance steer_delay throttle_delay steer_lag throttle_lag
-steer_offset steer_gain tire_saturation friction_change load_transfer motor_voltage_sag road_grade
-)";
+using mppi::cli::split_list;
+using mppi::cli::usage_error;
 
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-double number(const std::string& flag, const std::string& s) {
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(s, &used);
-    if (used == s.size()) return v;
-  } catch (const std::exception&) {
-  }
-  throw UsageError(flag + " expects a number, got '" + s + "'");
+// The nominal models that have an effects version (a corrected model).
+std::vector<std::string> nominal_models() {
+  std::vector<std::string> names;
+  for_each_type(CorrectedNominalModels{}, [&]<class D>() { names.emplace_back(D::kName); });
+  return names;
 }
 
-std::vector<std::string> split_list(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
+// "Effect ids: aero_drag rolling_resistance ...": from the effect table.
+std::string effect_ids_help() {
+  std::string out = "Effect ids:";
+  for (const EffectSpec& e : effect_library()) out += " " + e.id;
   return out;
 }
 
-int cmd_diagnose(int argc, char** argv) {
-  std::string log, params, validate, model = mppi::models::SingleTrackModel::kName;
+// The driver's speed: --speed V holds it constant, --speed-range MIN:MAX varies it.
+void add_driver_speed_options(CLI::App& cmd, SynthOptions& o) {
+  CLI::Option* speed = cmd.add_option_function<double>(
+                              "--speed",
+                              [&o](double v) {
+                                o.target_speed_mps = v;
+                                o.vary_speed = false;
+                              },
+                              "constant target speed [m/s]")
+                           ->type_name("V");
+  cmd.add_option_function<std::string>(
+         "--speed-range",
+         [&o](const std::string& text) {
+           const auto [lo, hi] = mppi::cli::parse_number_pair(text);
+           if (!(lo > 0 && hi >= lo)) throw usage_error("--speed-range", "need 0 < MIN <= MAX, got '" + text + "'");
+           o.speed_min_mps = lo;
+           o.speed_max_mps = hi;
+           o.vary_speed = true;
+         },
+         "the target speed changes every 2-6 s, uniform in [MIN, MAX] m/s (default 3:8)")
+      ->type_name("MIN:MAX")
+      ->check(mppi::cli::number_pair("MIN:MAX"))
+      ->excludes(speed);
+}
+
+struct DiagnoseArgs {
+  std::string log, params, validate, model = mppi::models::SingleTrackModel::kName, effects;
   DiagnoseOptions o;
-  o.out_dir = "out/diagnose";
-  for (int i = 1; i < argc; ++i) {
-    const std::string f = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw UsageError(f + " needs a value");
-      return argv[++i];
-    };
-    if (f == "--log") log = value();
-    else if (f == "--model") model = value();
-    else if (f == "--params") params = value();
-    else if (f == "--holdout") o.holdout = value();
-    else if (f == "--validate") validate = value();
-    else if (f == "--effects") o.selection.candidates = split_list(value());
-    else if (f == "--max-effects") o.selection.max_effects = static_cast<int>(number(f, value()));
-    else if (f == "--min-improvement") o.selection.min_val_improvement = number(f, value());
-    else if (f == "--min-bic-drop") o.selection.min_bic_drop = number(f, value());
-    else if (f == "--out") o.out_dir = value();
-    else if (f == "--no-plots") o.plots = false;
-    else if (f == "--help" || f == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else throw UsageError("unknown option " + f);
-  }
-  if (log.empty()) throw UsageError("--log FILE is required");
+  bool no_plots = false;
+  DiagnoseArgs() { o.out_dir = "out/diagnose"; }
+};
+
+int cmd_diagnose(DiagnoseArgs& args) {
+  const std::string &log = args.log, &params = args.params, &validate = args.validate, &model = args.model;
+  DiagnoseOptions o = args.o;
+  o.selection.candidates = split_list(args.effects);
+  o.plots = !args.no_plots;
+  if (log.empty()) throw usage_error("--log", "a recording (--log FILE) is required");
   for (const auto& id : o.selection.candidates) effect_spec(id);  // throws for unknown ids
   const auto nominal = make_model_family(model, params);  // throws for other models, bad files
   o.params_source = params;
@@ -136,74 +114,39 @@ int cmd_diagnose(int argc, char** argv) {
   return 0;
 }
 
-// "--speed-range A:B": the driver's target speed varies in [A, B] m/s.
-void speed_range(const std::string& flag, const std::string& text, SynthOptions* o) {
-  const auto colon = text.find(':');
-  if (colon == std::string::npos) throw UsageError(flag + " expects MIN:MAX, got '" + text + "'");
-  o->speed_min_mps = number(flag, text.substr(0, colon));
-  o->speed_max_mps = number(flag, text.substr(colon + 1));
-  if (!(o->speed_min_mps > 0 && o->speed_max_mps >= o->speed_min_mps))
-    throw UsageError(flag + ": need 0 < MIN <= MAX, got '" + text + "'");
-  o->vary_speed = true;
-}
-
-int cmd_synth(int argc, char** argv) {
+struct SynthArgs {
   SynthOptions o;
-  std::string out;
-  for (int i = 2; i < argc; ++i) {
-    const std::string f = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw UsageError(f + " needs a value");
-      return argv[++i];
-    };
-    if (f == "--out") out = value();
-    else if (f == "--effect") o.truth_ids = parse_effect_assignments(value(), &o.truth);
-    else if (f == "--seed") o.seed = static_cast<std::uint64_t>(number(f, value()));
-    else if (f == "--duration") o.duration_s = number(f, value());
-    else if (f == "--speed") {
-      o.target_speed_mps = number(f, value());
-      o.vary_speed = false;
-    } else if (f == "--speed-range") speed_range(f, value(), &o);
-    else if (f == "--samples") o.samples = static_cast<int>(number(f, value()));
-    else if (f == "--track") o.track = value();
-    else if (f == "--nominal") o.nominal_model = value();
-    else if (f == "--noise-scale") o.noise.scale = number(f, value());
-    else throw UsageError("unknown option " + f);
-  }
-  if (out.empty()) throw UsageError("synth: --out FILE.csv is required");
+  std::string out, effect;
+  double noise_scale = 1.0;
+};
+
+int cmd_synth(SynthArgs& args) {
+  SynthOptions o = args.o;
+  const std::string& out = args.out;
+  if (!args.effect.empty()) o.truth_ids = parse_effect_assignments(args.effect, &o.truth);
+  o.noise.scale = args.noise_scale;
+  if (out.empty()) throw usage_error("--out", "the recording to write (--out FILE.csv) is required");
   o.work_dir = out + ".work";
   const int crashes = synthesize(o, out);
   std::printf("wrote %s (hidden effects: %zu, crashes %d)\n", out.c_str(), o.truth_ids.size(), crashes);
   return 0;
 }
 
-int cmd_sweep(int argc, char** argv) {
+struct SweepArgs {
   int seeds = 3, clean = 4;
   SelectionOptions sel;
   SynthOptions driver;  // the driver's speed (schedule) for every recording
   double duration = 60;
-  std::vector<std::string> sizes = {"small", "large"}, effects;
-  std::string out = "out/diagnose_sweep";
-  for (int i = 2; i < argc; ++i) {
-    const std::string f = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw UsageError(f + " needs a value");
-      return argv[++i];
-    };
-    if (f == "--seeds") seeds = static_cast<int>(number(f, value()));
-    else if (f == "--clean") clean = static_cast<int>(number(f, value()));
-    else if (f == "--sizes") sizes = split_list(value());
-    else if (f == "--effects") effects = split_list(value());
-    else if (f == "--duration") duration = number(f, value());
-    else if (f == "--out") out = value();
-    else if (f == "--min-bic-drop") sel.min_bic_drop = number(f, value());
-    else if (f == "--nominal") driver.nominal_model = value();
-    else if (f == "--speed") {
-      driver.target_speed_mps = number(f, value());
-      driver.vary_speed = false;
-    } else if (f == "--speed-range") speed_range(f, value(), &driver);
-    else throw UsageError("unknown option " + f);
-  }
+  std::string sizes = "small,large", effects, out = "out/diagnose_sweep";
+};
+
+int cmd_sweep(SweepArgs& args) {
+  const int seeds = args.seeds, clean = args.clean;
+  const SelectionOptions& sel = args.sel;
+  const SynthOptions& driver = args.driver;
+  const double duration = args.duration;
+  const std::vector<std::string> sizes = split_list(args.sizes), effects = split_list(args.effects);
+  const std::string& out = args.out;
   for (const auto& id : effects) effect_spec(id);  // throws for unknown ids
   std::filesystem::create_directories(out);
   std::ofstream jsonl(out + "/runs.jsonl");
@@ -244,49 +187,44 @@ int cmd_sweep(int argc, char** argv) {
   return 0;
 }
 
-int cmd_loop(int argc, char** argv) {
-  sim::ClosedLoopConfig base;
-  base.plant = "corrected";
-  base.laps = 3;
-  base.target_speed_mps = 8.0;
-  base.controller.num_samples = 1024;
-  base.controller.horizon = 100;
-  base.progress = false;
-  base.actuators.steer_rate_per_s = 1e4f;
-  base.actuators.throttle_rate_per_s = 1e4f;
-  std::string truth_text, model_params, out = "out/diagnose_loop";
+struct LoopArgs {
+  sim::ClosedLoopConfig base = defaults();
+  std::string truth_text, case_text, model_params, out = "out/diagnose_loop";
   int seeds = 0;  // 0 = the one --seed
   std::string nominal = mppi::models::SingleTrackModel::kName;  // the plant's base and the nominal controller's model
-  for (int i = 2; i < argc; ++i) {
-    const std::string f = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw UsageError(f + " needs a value");
-      return argv[++i];
-    };
-    if (f == "--truth") truth_text = value();
-    else if (f == "--case") {  // ID:SIZE, the sweep's hidden effect of that size
-      const std::string v = value();
-      const auto colon = v.find(':');
-      const std::string id = v.substr(0, colon), size = colon == std::string::npos ? "large" : v.substr(colon + 1);
-      bool found = false;
-      for (const auto& c : sweep_cases())
-        if (c.id == id && (size == "small" || size == "large")) {
-          truth_text = size == "small" ? c.small : c.large;
-          found = true;
-        }
-      if (!found) throw UsageError("--case: expected EFFECT_ID:small|large, got '" + v + "'");
-    } else if (f == "--model-params") model_params = value();
-    else if (f == "--laps") base.laps = static_cast<int>(number(f, value()));
-    else if (f == "--speed") base.target_speed_mps = number(f, value());
-    else if (f == "--samples") base.controller.num_samples = static_cast<int>(number(f, value()));
-    else if (f == "--seed") base.controller.seed = static_cast<std::uint64_t>(number(f, value()));
-    else if (f == "--seeds") seeds = static_cast<int>(number(f, value()));
-    else if (f == "--nominal") nominal = value();
-    else if (f == "--track") base.track = value();
-    else if (f == "--out") out = value();
-    else throw UsageError("unknown option " + f);
+
+  static sim::ClosedLoopConfig defaults() {
+    sim::ClosedLoopConfig base;
+    base.plant = "corrected";
+    base.laps = 3;
+    base.target_speed_mps = 8.0;
+    base.controller.num_samples = 1024;
+    base.controller.horizon = 100;
+    base.progress = false;
+    base.actuators.steer_rate_per_s = 1e4f;
+    base.actuators.throttle_rate_per_s = 1e4f;
+    return base;
   }
-  if (model_params.empty()) throw UsageError("loop: --model-params FILE (the corrected model) is required");
+};
+
+int cmd_loop(LoopArgs& args) {
+  sim::ClosedLoopConfig base = args.base;
+  std::string truth_text = args.truth_text;
+  const std::string &model_params = args.model_params, &out = args.out, &nominal = args.nominal;
+  const int seeds = args.seeds;
+  if (!args.case_text.empty()) {  // ID:SIZE, the sweep's hidden effect of that size
+    const std::string& v = args.case_text;
+    const auto colon = v.find(':');
+    const std::string id = v.substr(0, colon), size = colon == std::string::npos ? "large" : v.substr(colon + 1);
+    bool found = false;
+    for (const auto& c : sweep_cases())
+      if (c.id == id && (size == "small" || size == "large")) {
+        truth_text = size == "small" ? c.small : c.large;
+        found = true;
+      }
+    if (!found) throw usage_error("--case", "expected EFFECT_ID:small|large, got '" + v + "'");
+  }
+  if (model_params.empty()) throw usage_error("--model-params", "the corrected model (--model-params FILE) is required");
   std::filesystem::create_directories(out);
   CorrectedModelFile truth;
   truth.selected = parse_effect_assignments(truth_text, &truth.effects);
@@ -359,20 +297,108 @@ int cmd_loop(int argc, char** argv) {
   return 0;
 }
 
+// A command's run: mppi::Error (bad data, bad effect ids) exits 1 with the message.
+template <class Args>
+std::function<int()> guarded(std::shared_ptr<Args> args, int (*run)(Args&)) {
+  return [args, run] {
+    try {
+      return run(*args);
+    } catch (const mppi::Error& e) {
+      std::fprintf(stderr, "mppi-fit diagnose: error: %s\n", e.what());
+      return 1;
+    }
+  };
+}
+
+void add_diagnose_options(CLI::App& cmd, DiagnoseArgs& a) {
+  cmd.add_option("--log", a.log,
+                 "recording (docs/RECORDING_FORMAT.md), or a real recording (DART / ETH CSV, or "
+                 "ARCHIVE.zip:MEMBER.csv), converted on the fly (sysid/real_data.hpp)")
+      ->type_name("FILE");
+  mppi::cli::add_model_option(cmd, "--model", a.model, "nominal model", nominal_models());
+  cmd.add_option("--params", a.params,
+                 "nominal parameters: that model's YAML (keys: mppi-sim --list-models) or a corrected-model file "
+                 "(default: the library defaults, e.g. data/config/autorally_single_track.yaml)")
+      ->type_name("FILE");
+  cmd.add_option("--holdout", a.o.holdout, "held-out fraction at the end, or time range T0:T1 [s]")->type_name("H");
+  cmd.add_option("--validate", a.validate, "fit on all of --log, judge on this other recording (replaces --holdout)")
+      ->type_name("FILE");
+  cmd.add_option("--effects", a.effects, "candidate effect ids (default: all)")->type_name("A,B,...");
+  cmd.add_option("--max-effects", a.o.selection.max_effects, "at most N effects named")->type_name("N");
+  cmd.add_option("--min-improvement", a.o.selection.min_val_improvement,
+                 "validation-cost reduction an effect must give")
+      ->type_name("F");
+  cmd.add_option("--min-bic-drop", a.o.selection.min_bic_drop, "and BIC decrease")->type_name("B");
+  mppi::cli::add_out_option(cmd, a.o.out_dir, "report.json, report.md, PNG plots, corrected_model.yaml");
+  cmd.add_flag("--no-plots", a.no_plots, "skip the PNG plots");
+}
+
+void add_synth_options(CLI::App& cmd, SynthArgs& a) {
+  cmd.add_option("--out", a.out, "the recording to write (required)")->type_name("FILE.csv");
+  cmd.add_option("--effect", a.effect, "hidden effects and their values")->type_name("key=value,...");
+  mppi::cli::add_seed_option(cmd, a.o.seed, "MPPI and noise seed");
+  cmd.add_option("--duration", a.o.duration_s, "recording length [s]")->type_name("S");
+  add_driver_speed_options(cmd, a.o);
+  cmd.add_option("--samples", a.o.samples, "MPPI samples")->type_name("K");
+  mppi::cli::add_track_option(cmd, a.o.track);
+  cmd.add_option("--noise-scale", a.noise_scale, "scale of the sensor noise")->type_name("F");
+  mppi::cli::add_model_option(cmd, "--nominal", a.o.nominal_model, "the truth's base model", nominal_models());
+}
+
+void add_sweep_options(CLI::App& cmd, SweepArgs& a) {
+  cmd.add_option("--seeds", a.seeds, "seeds per effect and size")->type_name("N");
+  cmd.add_option("--sizes", a.sizes, "effect sizes")->type_name("small,large");
+  cmd.add_option("--effects", a.effects, "effect ids (default: all the sweep's cases)")->type_name("A,B,...");
+  cmd.add_option("--clean", a.clean, "recordings without a hidden effect")->type_name("N");
+  cmd.add_option("--duration", a.duration, "recording length [s]")->type_name("S");
+  add_driver_speed_options(cmd, a.driver);
+  cmd.add_option("--min-bic-drop", a.sel.min_bic_drop, "BIC decrease an effect must give")->type_name("B");
+  mppi::cli::add_model_option(cmd, "--nominal", a.driver.nominal_model, "truth base and diagnosed nominal",
+                              nominal_models());
+  mppi::cli::add_out_option(cmd, a.out, "recordings, runs.jsonl, sweep.md (recordings already there are reused)");
+}
+
+void add_loop_options(CLI::App& cmd, LoopArgs& a) {
+  CLI::Option* truth = cmd.add_option("--truth", a.truth_text, "the plant's hidden effects")->type_name("key=value,...");
+  cmd.add_option("--case", a.case_text, "the sweep's hidden effect of that size")
+      ->type_name("ID:small|large")
+      ->excludes(truth);
+  cmd.add_option("--model-params", a.model_params, "the corrected model (required)")->type_name("FILE");
+  cmd.add_option("--laps", a.base.laps, "laps per run")->type_name("N");
+  cmd.add_option("--speed", a.base.target_speed_mps, "target speed [m/s]")->type_name("V");
+  cmd.add_option("--samples", a.base.controller.num_samples, "MPPI samples")->type_name("K");
+  mppi::cli::add_seed_option(cmd, a.base.controller.seed);
+  cmd.add_option("--seeds", a.seeds, "seeds 1..N and a mean +- sd summary (0: the one --seed)")->type_name("N");
+  mppi::cli::add_model_option(cmd, "--nominal", a.nominal, "the plant's base and the nominal controller's model",
+                              nominal_models());
+  mppi::cli::add_track_option(cmd, a.base.track);
+  mppi::cli::add_out_option(cmd, a.out, "one folder per run");
+}
+
 }  // namespace
 
-int mppi_fit_diagnose(int argc, char** argv) {
-  try {
-    const std::string sub = argc > 1 ? argv[1] : "";
-    if (sub == "synth") return cmd_synth(argc, argv);
-    if (sub == "sweep") return cmd_sweep(argc, argv);
-    if (sub == "loop") return cmd_loop(argc, argv);
-    return cmd_diagnose(argc, argv);
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "mppi-fit diagnose: %s\n%s", e.what(), kUsage);
-    return 2;
-  } catch (const mppi::Error& e) {
-    std::fprintf(stderr, "mppi-fit diagnose: error: %s\n", e.what());
-    return 1;
-  }
+void add_diagnose_command(CLI::App& fit, FitCommands& commands) {
+  CLI::App* diag = fit.add_subcommand(
+      "diagnose", "compare a recording against the simulator's prediction (sim vs real): locate, name, model, show");
+  diag->require_subcommand(0, 1);
+  diag->footer(effect_ids_help());
+  auto diagnose = std::make_shared<DiagnoseArgs>();
+  add_diagnose_options(*diag, *diagnose);
+  commands.add(diag, guarded(diagnose, &cmd_diagnose));
+
+  auto synth = std::make_shared<SynthArgs>();
+  CLI::App* synth_cmd = diag->add_subcommand("synth", "a synthetic recording with concealed effects");
+  synth_cmd->footer(effect_ids_help());
+  add_synth_options(*synth_cmd, *synth);
+  commands.add(synth_cmd, guarded(synth, &cmd_synth));
+
+  auto sweep = std::make_shared<SweepArgs>();
+  CLI::App* sweep_cmd = diag->add_subcommand("sweep", "seeds x effects x sizes: effects named right / wrong, RMSE");
+  add_sweep_options(*sweep_cmd, *sweep);
+  commands.add(sweep_cmd, guarded(sweep, &cmd_sweep));
+
+  auto loop = std::make_shared<LoopArgs>();
+  CLI::App* loop_cmd = diag->add_subcommand("loop", "closed loop: MPPI with the nominal vs the corrected model");
+  add_loop_options(*loop_cmd, *loop);
+  commands.add(loop_cmd, guarded(loop, &cmd_loop));
 }

@@ -4,12 +4,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "cli/app.hpp"
+#include "cli/options.hpp"
 #include "dynamics/vehicle_params.hpp"
 #include "dynamics/model_registry.hpp"
 #include "mppi/error.hpp"
@@ -22,60 +26,6 @@
 
 namespace {
 
-const char* kEstimateUsage = R"(usage: mppi-fit estimate RECORDING [options]
-  RECORDING            a recording (docs/RECORDING_FORMAT.md), or a shipped raw one converted on
-                       the fly: real/dart_jetracer.zip:<member>.csv (see mppi-fit convert --list)
-  --model NAME         single-track | double-track | full-vehicle          (single-track)
-  --params FILE        base parameters (YAML of that model; default data/config/autorally_<model>.yaml)
-  --estimate A,B,...   parameters to estimate (YAML keys, tyre.B etc.; default: see --list-params)
-  --list-params        print the parameter names of the model and exit
-  --estimator NAME     alm (ALM-UKF) | ukf (standard joint-state UKF)      (alm)
-  --alm-window S       noise samples from the last S seconds               (10)
-  --alm-process        also re-estimate Q (off: Q and R together drift, see docs)
-  --fit T0:T1          fit on rows with t in [T0, T1) s                    (all)
-  --validate T0:T1     held-out rows of the same recording for validation
-  --validate-recording FILE   held-out recording (instead of a window)
-  --horizon S          validation rollouts restarted every S seconds       (1)
-  --measure A,B,...    recording columns used as measurements (default: all the model has)
-  --meas-std C=SD,...  measurement noise std overrides (initial R for the ALM)
-  --param-std F        initial std of log(parameter) (linear ones: absolute) (0.3)
-  --walk-std F         parameter random walk per sqrt(s), rescaled each step (0.003)
-  --process-scale F    scale of the model's process noise                  (1)
-  --keep-wheelbase     estimating cg_to_front_axle_m moves the CG, wheelbase fixed
-  --truth FILE         true parameters (simulated data): report each parameter's error
-  --observability      print the observability check of the joint-state model and exit
-  --rank-tol F         singular values below F x the largest count as zero (1e-7)
-  --out DIR            estimated.yaml, convergence.csv/.png, validation.png, parameters.csv,
-                       summary.txt                                         (out/estimate)
-)";
-
-std::vector<std::string> split_list(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
-double number(const std::string& flag, const std::string& s) {
-  std::size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(s, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != s.size() || s.empty()) throw mppi::Error(flag + " expects a number, got '" + s + "'");
-  return v;
-}
-
-std::pair<double, double> window(const std::string& flag, const std::string& s) {
-  const std::size_t c = s.find(':');
-  if (c == std::string::npos) throw mppi::Error(flag + " expects T0:T1, got '" + s + "'");
-  return {number(flag, s.substr(0, c)), number(flag, s.substr(c + 1))};
-}
-
 std::string resolve(const std::string& spec) {
   if (spec.rfind("real/", 0) != 0) return spec;
   const std::size_t z = spec.find(".zip:");
@@ -83,106 +33,66 @@ std::string resolve(const std::string& spec) {
                                 : mppi::sim::data_file(spec.substr(0, z + 4)) + spec.substr(z + 4);
 }
 
-}  // namespace
+// What the command line sets.
+struct EstimateArgs {
+  std::string input, model = mppi::models::SingleTrackModel::kName, params_file, out_dir = "out/estimate",
+                     truth_file, val_file, estimator = "alm", fit_text, val_text, estimate_text, measure_text,
+                     meas_std_text;
+  mppi::sysid::EstimateSettings st;
+  bool list_params = false, observe = false, keep_wheelbase = false;
+  double horizon_s = 1.0, rank_tol = 1e-7;
+};
 
-int mppi_fit_estimate(int argc, char** argv) {
+// The models estimate has a joint-state version of (sysid/vehicle_estimation.hpp).
+std::vector<std::string> estimable_models() {
+  return {mppi::models::SingleTrackModel::kName, mppi::models::DoubleTrackModel::kName,
+          mppi::models::FullVehicleModel::kName};
+}
+
+std::vector<std::string> estimable_params(const std::string& model) {
+  using namespace mppi::sysid;
+  return model == mppi::models::SingleTrackModel::kName   ? single_track_param_names()
+         : model == mppi::models::DoubleTrackModel::kName ? double_track_param_names()
+                                                          : full_vehicle_param_names();
+}
+
+int run_estimate(EstimateArgs& args) {
   using namespace mppi;
   using namespace mppi::sysid;
-  std::string input, model = mppi::models::SingleTrackModel::kName, params_file, out_dir = "out/estimate", truth_file, val_file;
-  std::vector<std::string> estimate_names;
-  EstimateSettings st;
-  bool have_fit = false, have_val = false, list_params = false, observe = false, keep_wheelbase = false;
+  using mppi::cli::usage_error;
+  const std::string input = args.input, model = args.model, params_file = args.params_file,
+                    out_dir = args.out_dir, truth_file = args.truth_file, val_file = args.val_file;
+  EstimateSettings st = args.st;
+  const bool observe = args.observe, keep_wheelbase = args.keep_wheelbase;
+  const double horizon_s = args.horizon_s, rank_tol = args.rank_tol;
+  std::vector<std::string> estimate_names = mppi::cli::split_list(args.estimate_text);
+  const bool have_fit = !args.fit_text.empty(), have_val = !args.val_text.empty();
   std::pair<double, double> fit{-1e300, 1e300}, val{0, 0};
-  double horizon_s = 1.0, rank_tol = 1e-7;
-  try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string a = argv[i];
-      auto value = [&]() -> std::string {
-        if (i + 1 >= argc) throw Error(a + " expects a value");
-        return argv[++i];
-      };
-      if (a == "--help" || a == "-h") {
-        std::fputs(kEstimateUsage, stdout);
-        return 0;
-      } else if (a == "--model") {
-        model = value();
-        if (model != mppi::models::SingleTrackModel::kName && model != mppi::models::DoubleTrackModel::kName && model != mppi::models::FullVehicleModel::kName)
-          throw Error("--model expects single-track, double-track or full-vehicle, got '" + model + "'");
-      } else if (a == "--params") {
-        params_file = value();
-      } else if (a == "--estimate") {
-        estimate_names = split_list(value());
-      } else if (a == "--list-params") {
-        list_params = true;
-      } else if (a == "--estimator") {
-        const std::string e = value();
-        if (e != "alm" && e != "ukf") throw Error("--estimator expects alm or ukf, got '" + e + "'");
-        st.adaptive = e == "alm";
-      } else if (a == "--alm-window") {
-        st.alm_window_s = number(a, value());
-      } else if (a == "--alm-process") {
-        st.alm_process = true;
-      } else if (a == "--fit") {
-        fit = window(a, value());
-        have_fit = true;
-      } else if (a == "--validate") {
-        val = window(a, value());
-        have_val = true;
-      } else if (a == "--validate-recording") {
-        val_file = value();
-      } else if (a == "--horizon") {
-        horizon_s = number(a, value());
-      } else if (a == "--measure") {
-        st.measure = split_list(value());
-      } else if (a == "--meas-std") {
-        for (const auto& kv : split_list(value())) {
-          const std::size_t eq = kv.find('=');
-          if (eq == std::string::npos) throw Error("--meas-std expects COLUMN=STD, got '" + kv + "'");
-          st.measurement_std.emplace_back(kv.substr(0, eq), number(a, kv.substr(eq + 1)));
-        }
-      } else if (a == "--param-std") {
-        st.param_initial_std = number(a, value());
-      } else if (a == "--walk-std") {
-        st.param_walk_std_per_s = number(a, value());
-      } else if (a == "--process-scale") {
-        st.process_noise_scale = number(a, value());
-      } else if (a == "--keep-wheelbase") {
-        keep_wheelbase = true;
-      } else if (a == "--truth") {
-        truth_file = value();
-      } else if (a == "--observability") {
-        observe = true;
-      } else if (a == "--rank-tol") {
-        rank_tol = number(a, value());
-      } else if (a == "--out") {
-        out_dir = value();
-      } else if (!a.empty() && a[0] == '-') {
-        throw Error("unknown option " + a);
-      } else if (input.empty()) {
-        input = a;
-      } else {
-        throw Error("more than one recording given");
-      }
-    }
-    if (list_params) {
-      for (const auto& n : model == mppi::models::SingleTrackModel::kName   ? single_track_param_names()
-                           : model == mppi::models::DoubleTrackModel::kName ? double_track_param_names()
-                                                     : full_vehicle_param_names())
-        std::printf("%s\n", n.c_str());
-      return 0;
-    }
-    if (input.empty()) throw Error("no recording given");
-    if (have_fit) {
-      st.t_begin_s = fit.first;
-      st.t_end_s = fit.second;
-    }
-    std::string why;
-    if (!st.is_valid(&why)) throw Error(why);
-    if (!(horizon_s > 0)) throw Error("--horizon must be > 0");
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mppi-fit estimate: %s\n%s", e.what(), kEstimateUsage);
-    return 2;
+  if (have_fit) fit = mppi::cli::parse_number_pair(args.fit_text);
+  if (have_val) val = mppi::cli::parse_number_pair(args.val_text);
+  st.adaptive = args.estimator == "alm";
+  st.measure = mppi::cli::split_list(args.measure_text);
+  for (const auto& kv : mppi::cli::split_list(args.meas_std_text)) {
+    const std::size_t eq = kv.find('=');
+    char* end = nullptr;
+    const double sd = eq == std::string::npos ? 0.0 : std::strtod(kv.c_str() + eq + 1, &end);
+    if (eq == std::string::npos || end == kv.c_str() + eq + 1 || *end != '\0')
+      throw usage_error("--meas-std", "expects COLUMN=STD,..., got '" + kv + "'");
+    st.measurement_std.emplace_back(kv.substr(0, eq), sd);
   }
+  if (args.list_params) {
+    // The estimable parameters, described by the model's parameter table.
+    std::fputs(mppi::cli::model_parameter_help(model, estimable_params(model)).c_str(), stdout);
+    return 0;
+  }
+  if (input.empty()) throw usage_error("RECORDING", "no recording given");
+  if (have_fit) {
+    st.t_begin_s = fit.first;
+    st.t_end_s = fit.second;
+  }
+  std::string why;
+  if (!st.is_valid(&why)) throw CLI::ValidationError(why);
+  if (!(horizon_s > 0)) throw usage_error("--horizon", "must be > 0");
 
   try {
     // Model and its base parameters.
@@ -463,4 +373,63 @@ int mppi_fit_estimate(int argc, char** argv) {
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+void add_estimate_command(CLI::App& fit, FitCommands& commands) {
+  auto args = std::make_shared<EstimateArgs>();
+  mppi::sysid::EstimateSettings& st = args->st;
+  CLI::App* cmd = fit.add_subcommand(
+      "estimate", "estimate model parameters from a recording (UKF, joint UKF, ALM-UKF); docs/ESTIMATION.md");
+  cmd->add_option("recording", args->input,
+                  "a recording (docs/RECORDING_FORMAT.md), or a shipped raw one converted on the fly: "
+                  "real/dart_jetracer.zip:<member>.csv (see mppi-fit convert --list)")
+      ->type_name("RECORDING");
+  mppi::cli::add_model_option(*cmd, "--model", args->model, "model", estimable_models());
+  cmd->add_option("--params", args->params_file,
+                  "base parameters (YAML of that model, keys in --list-params; default "
+                  "data/config/autorally_<model>.yaml)")
+      ->type_name("FILE");
+  cmd->add_option("--estimate", args->estimate_text, "parameters to estimate (YAML keys, tyre.B etc.; default: a "
+                                                     "model's usual set)")
+      ->type_name("A,B,...");
+  cmd->add_flag("--list-params", args->list_params,
+                "print the estimable parameters of the model (from its parameter table) and exit");
+  cmd->add_option("--estimator", args->estimator, "alm (ALM-UKF) | ukf (standard joint-state UKF)")
+      ->type_name("NAME")
+      ->check(CLI::IsMember({"alm", "ukf"}).description(""));
+  cmd->add_option("--alm-window", st.alm_window_s, "noise samples from the last S seconds")->type_name("S");
+  cmd->add_flag("--alm-process", st.alm_process, "also re-estimate Q (off: Q and R together drift, see docs)");
+  cmd->add_option("--fit", args->fit_text, "fit on rows with t in [T0, T1) s (default all)")
+      ->type_name("T0:T1")
+      ->check(mppi::cli::number_pair());
+  cmd->add_option("--validate", args->val_text, "held-out rows of the same recording for validation")
+      ->type_name("T0:T1")
+      ->check(mppi::cli::number_pair());
+  cmd->add_option("--validate-recording", args->val_file, "held-out recording (instead of a window)")
+      ->type_name("FILE");
+  cmd->add_option("--horizon", args->horizon_s, "validation rollouts restarted every S seconds")->type_name("S");
+  cmd->add_option("--measure", args->measure_text,
+                  "recording columns used as measurements (default: all the model has)")
+      ->type_name("A,B,...");
+  cmd->add_option("--meas-std", args->meas_std_text, "measurement noise std overrides (initial R for the ALM)")
+      ->type_name("C=SD,...");
+  cmd->add_option("--param-std", st.param_initial_std, "initial std of log(parameter) (linear ones: absolute)")
+      ->type_name("F");
+  cmd->add_option("--walk-std", st.param_walk_std_per_s, "parameter random walk per sqrt(s), rescaled each step")
+      ->type_name("F");
+  cmd->add_option("--process-scale", st.process_noise_scale, "scale of the model's process noise")->type_name("F");
+  cmd->add_flag("--keep-wheelbase", args->keep_wheelbase, "estimating cg_to_front_axle_m moves the CG, wheelbase fixed");
+  cmd->add_option("--truth", args->truth_file, "true parameters (simulated data): report each parameter's error")
+      ->type_name("FILE");
+  cmd->add_flag("--observability", args->observe, "print the observability check of the joint-state model and exit");
+  cmd->add_option("--rank-tol", args->rank_tol, "singular values below F x the largest count as zero")
+      ->type_name("F");
+  mppi::cli::add_out_option(*cmd, args->out_dir,
+                            "estimated.yaml, convergence.csv/.png, validation.png, parameters.csv, summary.txt");
+  cmd->footer(mppi::cli::model_parameter_help(mppi::models::SingleTrackModel::kName,
+                                              estimable_params(mppi::models::SingleTrackModel::kName)) +
+              "(another model's: --list-params --model NAME)");
+  commands.add(cmd, [args] { return run_estimate(*args); });
 }

@@ -1,12 +1,13 @@
 // mppi-fit protocol: the paper's estimation protocol in simulation (sysid/protocol.hpp).
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <exception>
-#include <stdexcept>
+#include <memory>
 #include <string>
 
+#include "cli/app.hpp"
+#include "cli/options.hpp"
+#include "dynamics/models/full_vehicle.hpp"
 #include "dynamics/vehicle_params.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"
@@ -15,80 +16,71 @@
 
 namespace {
 
-const char* kProtocolUsage = R"(usage: mppi-fit protocol [options]
-Drives the simulated full-vehicle plant (known parameters) through the paper's five manoeuvres
-(low speed, zig-zag, straight acceleration and braking, sliding, high speed; 20 s of each) and a
-held-out 13 s lap-like segment, with sensor noise. By default the manoeuvres are interleaved as a
-human driver mixes them (a 20 s cycle of five 4 s pieces, repeated); --layout sequential drives
-each for its whole 20 s in turn. Writes DIR/train.csv, DIR/validation.csv
-(measured, docs/RECORDING_FORMAT.md), DIR/truth.csv (noise-free states), DIR/truth.yaml,
-DIR/protocol.png.
-  --params FILE       full-vehicle parameters of the plant (default data/config/autorally_full_vehicle.yaml)
-  --out DIR           output folder (default out/protocol)
-  --seed N            sensor-noise seed (1)
-  --manoeuvre-s S     total time in each manoeuvre (20)
-  --layout L          interleaved | sequential (interleaved)
-  --piece-s S         interleaved: duration of one manoeuvre piece (4; cycle = 5 pieces)
-  --validation-s S    duration of the held-out segment (13)
-  --noise-scale F     multiply every sensor-noise standard deviation by F (1; 0 = no noise)
-)";
-
-}  // namespace
-
-int mppi_fit_protocol(int argc, char** argv) {
-  std::string params_path, out = "out/protocol";
+struct ProtocolArgs {
+  std::string params_path, out = "out/protocol", layout = "interleaved";
   mppi::sysid::ProtocolOptions options;
   double noise_scale = 1.0;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    if (flag == "--help" || flag == "-h") {
-      std::fputs(kProtocolUsage, stdout);
-      return 0;
-    }
-    if (i + 1 >= argc) {
-      std::fprintf(stderr, "mppi-fit protocol: %s needs a value\n%s", flag.c_str(), kProtocolUsage);
-      return 2;
-    }
-    const char* value = argv[++i];
-    char* end = nullptr;
-    auto number = [&]() {
-      const double v = std::strtod(value, &end);
-      if (end == value || *end != '\0') throw std::invalid_argument(flag + ": not a number: " + value);
-      return v;
-    };
-    try {
-      if (flag == "--params") params_path = value;
-      else if (flag == "--out") out = value;
-      else if (flag == "--seed") options.seed = static_cast<std::uint64_t>(number());
-      else if (flag == "--manoeuvre-s") options.manoeuvre_duration_s = number();
-      else if (flag == "--layout") options.layout = mppi::sysid::parse_protocol_layout(value);
-      else if (flag == "--piece-s") options.piece_duration_s = number();
-      else if (flag == "--validation-s") options.validation_duration_s = number();
-      else if (flag == "--noise-scale") noise_scale = number();
-      else {
-        std::fprintf(stderr, "mppi-fit protocol: unknown option %s\n%s", flag.c_str(), kProtocolUsage);
-        return 2;
-      }
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "mppi-fit protocol: %s\n", e.what());
-      return 2;
-    }
+};
+
+int run_protocol(ProtocolArgs& args) {
+  mppi::sysid::ProtocolOptions options = args.options;
+  try {
+    options.layout = mppi::sysid::parse_protocol_layout(args.layout);
+  } catch (const std::exception& e) {
+    throw mppi::cli::usage_error("--layout", e.what());
   }
   for (double* s : {&options.position_noise_m, &options.yaw_noise_rad, &options.velocity_noise_mps,
                     &options.rate_noise_radps, &options.angle_noise_rad, &options.accel_noise_mps2,
                     &options.wheel_noise_radps})
-    *s *= noise_scale;
+    *s *= args.noise_scale;
   try {
     const mppi::FullVehicleParams params = mppi::load_full_vehicle_params(
-        params_path.empty() ? mppi::sim::data_file("config/autorally_full_vehicle.yaml") : params_path);
+        args.params_path.empty() ? mppi::sim::data_file("config/autorally_full_vehicle.yaml") : args.params_path);
     const auto run = mppi::sysid::run_protocol(params, options);
-    mppi::sysid::write_protocol(run, params, out);
-    mppi::sysid::plot_protocol(run, out + "/protocol.png");
+    mppi::sysid::write_protocol(run, params, args.out);
+    mppi::sysid::plot_protocol(run, args.out + "/protocol.png");
     std::printf("protocol: %zu training rows, %zu validation rows -> %s/{train,validation,truth}.csv, truth.yaml, protocol.png\n",
-                run.training.rows(), run.validation.rows(), out.c_str());
+                run.training.rows(), run.validation.rows(), args.out.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mppi-fit protocol: %s\n", e.what());
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+void add_protocol_command(CLI::App& fit, FitCommands& commands) {
+  auto args = std::make_shared<ProtocolArgs>();
+  mppi::sysid::ProtocolOptions& o = args->options;
+  CLI::App* cmd = fit.add_subcommand("protocol", "simulate the paper's estimation manoeuvres on the full-vehicle plant");
+  cmd->footer(
+      "Drives the simulated full-vehicle plant (known parameters) through the paper's five manoeuvres\n"
+      "(low speed, zig-zag, straight acceleration and braking, sliding, high speed; 20 s of each) and a\n"
+      "held-out 13 s lap-like segment, with sensor noise. By default the manoeuvres are interleaved as a\n"
+      "human driver mixes them (a 20 s cycle of five 4 s pieces, repeated); --layout sequential drives\n"
+      "each for its whole 20 s in turn. Writes DIR/train.csv, DIR/validation.csv\n"
+      "(measured, docs/RECORDING_FORMAT.md), DIR/truth.csv (noise-free states), DIR/truth.yaml,\n"
+      "DIR/protocol.png.\n\n" +
+      mppi::cli::model_parameter_help(mppi::models::FullVehicleModel::kName));
+  cmd->add_option("--params", args->params_path,
+                  "full-vehicle parameters of the plant (YAML, keys below; default "
+                  "data/config/autorally_full_vehicle.yaml)")
+      ->type_name("FILE");
+  mppi::cli::add_out_option(*cmd, args->out, "output folder");
+  mppi::cli::add_seed_option(*cmd, o.seed, "sensor-noise seed");
+  cmd->add_option("--manoeuvre-s", o.manoeuvre_duration_s, "total time in each manoeuvre")->type_name("S");
+  using mppi::sysid::ProtocolLayout;
+  cmd->add_option("--layout", args->layout, "interleaved | sequential")
+      ->type_name("L")
+      ->check(CLI::IsMember({mppi::sysid::protocol_layout_name(ProtocolLayout::interleaved),
+                             mppi::sysid::protocol_layout_name(ProtocolLayout::sequential)})
+                  .description(""));
+  cmd->add_option("--piece-s", o.piece_duration_s, "interleaved: duration of one manoeuvre piece (cycle = 5 pieces)")
+      ->type_name("S");
+  cmd->add_option("--validation-s", o.validation_duration_s, "duration of the held-out segment")->type_name("S");
+  cmd->add_option("--noise-scale", args->noise_scale,
+                  "multiply every sensor-noise standard deviation by F (0 = no noise)")
+      ->type_name("F");
+  commands.add(cmd, [args] { return run_protocol(*args); });
 }
