@@ -7,12 +7,13 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <thread>
 
 #include "chassis/chassis.hpp"
 #include "chassis/udp_adapter.hpp"
+#include "cli/app.hpp"
+#include "cli/options.hpp"
 #include "dynamics/single_track.hpp"
 #include "dynamics/vehicle_params.hpp"
 #include "mppi/error.hpp"
@@ -23,32 +24,8 @@
 
 namespace {
 
-constexpr const char* kUsage = R"(usage: mppi-udp-bridge [options]
-  --bind ADDR          IPv4 address to listen on                (127.0.0.1: loopback only)
-  --port N             UDP port                                  (47800)
-  --rate HZ            chassis rate                              (100)
-  --calibration FILE   chassis calibration YAML                  (data/config/chassis_calibration.yaml)
-  --priorities FILE    controller priorities YAML                (data/config/chassis_priorities.yaml)
-  --stop-throttle V    throttle while stopped, in [-1, 0]        (0: neutral)
-  --track NAME         track the simulated car starts on         (gazebo)
-  --duration S         stop after S seconds; 0 = until Ctrl-C    (0)
-  --quiet              no status line per second
-)";
-
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
-
-[[noreturn]] void usage_error(const std::string& msg) {
-  std::fprintf(stderr, "mppi-udp-bridge: %s\n%s", msg.c_str(), kUsage);
-  std::exit(2);
-}
-
-double number(const std::string& flag, const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0') usage_error(flag + " expects a number, got '" + text + "'");
-  return v;
-}
 
 }  // namespace
 
@@ -60,26 +37,21 @@ int main(int argc, char** argv) {
   double rate_hz = 100.0, duration_s = 0.0;
   bool quiet = false;
   SafetySettings safety;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage_error(flag + " needs a value");
-      return argv[++i];
-    };
-    if (flag == "--help" || flag == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else if (flag == "--bind") bind = value();
-    else if (flag == "--port") port = static_cast<int>(number(flag, value()));
-    else if (flag == "--rate") rate_hz = number(flag, value());
-    else if (flag == "--calibration") calibration_file = value();
-    else if (flag == "--priorities") priorities_file = value();
-    else if (flag == "--stop-throttle") safety.stop_throttle = static_cast<float>(number(flag, value()));
-    else if (flag == "--track") track_name = value();
-    else if (flag == "--duration") duration_s = number(flag, value());
-    else if (flag == "--quiet") quiet = true;
-    else usage_error("unknown option " + flag);
-  }
+  CLI::App app{"The vehicle end of the UDP chassis interface, in front of a simulated car (docs/CHASSIS.md).",
+               "mppi-udp-bridge"};
+  cli::configure(app);
+  app.add_option("--bind", bind, "IPv4 address to listen on (127.0.0.1: loopback only)")->type_name("ADDR");
+  app.add_option("--port", port, "UDP port")->type_name("N")->check(CLI::Range(0, 65535).description(""));
+  app.add_option("--rate", rate_hz, "chassis rate [Hz]")->type_name("HZ")->check(CLI::PositiveNumber.description(""));
+  app.add_option("--calibration", calibration_file, "chassis calibration YAML (default data/config/chassis_calibration.yaml)")
+      ->type_name("FILE");
+  app.add_option("--priorities", priorities_file, "controller priorities YAML (default data/config/chassis_priorities.yaml)")
+      ->type_name("FILE");
+  app.add_option("--stop-throttle", safety.stop_throttle, "throttle while stopped, in [-1, 0] (0: neutral)")->type_name("V");
+  cli::add_track_option(app, track_name, "track the simulated car starts on");
+  app.add_option("--duration", duration_s, "stop after S seconds; 0 = until Ctrl-C")->type_name("S");
+  app.add_flag("--quiet", quiet, "no status line per second");
+  if (const int rc = cli::parse(app, argc, argv); rc >= 0) return rc;
   try {
     const Calibration calibration = Calibration::load_yaml(
         calibration_file.empty() ? sim::data_file("config/chassis_calibration.yaml") : calibration_file);

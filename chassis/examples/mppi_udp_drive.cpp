@@ -6,7 +6,6 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
-#include <cstdlib>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -16,6 +15,8 @@
 
 #include "chassis/control_loop.hpp"
 #include "chassis/udp_adapter.hpp"
+#include "cli/app.hpp"
+#include "cli/options.hpp"
 #include "costs/autorally_cost.hpp"
 #include "costs/cost_config.hpp"
 #include "costs/cost_map.hpp"
@@ -30,36 +31,8 @@
 
 namespace {
 
-constexpr const char* kUsage = R"(usage: mppi-udp-drive [options]
-  --host ADDR          chassis address                          (127.0.0.1)
-  --port N             chassis UDP port                         (47800)
-  --name NAME          controller name in the priorities        (mppi)
-  --runstop-name NAME  runstop source name                      (OCS)
-  --model NAME         autorally-nn | kinematic                 (autorally-nn)
-  --track NAME         track of the cost map                    (gazebo)
-  --speed MPS          target speed                             (6)
-  --rate HZ            controller rate                          (50)
-  --samples K          MPPI samples                             (1920)
-  --horizon T          MPPI time steps                          (100)
-  --threads N          CPU threads, 0 = all                     (0)
-  --seed N             noise seed                               (1)
-  --duration S         stop after S seconds; 0 = until Ctrl-C   (30)
-  --param-port N       UDP port for parameter messages, 0 = off (47801)
-)";
-
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
-
-[[noreturn]] void usage_error(const std::string& msg) {
-  std::fprintf(stderr, "mppi-udp-drive: %s\n%s", msg.c_str(), kUsage);
-  std::exit(2);
-}
-double number(const std::string& flag, const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0') usage_error(flag + " expects a number, got '" + text + "'");
-  return v;
-}
 
 }  // namespace
 
@@ -72,31 +45,29 @@ int main(int argc, char** argv) {
   double speed = 6.0, duration_s = 30.0;
   ControlLoopSettings loop_settings;
   ControllerOptions options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage_error(flag + " needs a value");
-      return argv[++i];
-    };
-    if (flag == "--help" || flag == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else if (flag == "--host") host = value();
-    else if (flag == "--port") port = static_cast<int>(number(flag, value()));
-    else if (flag == "--name") name = value();
-    else if (flag == "--runstop-name") runstop_name = value();
-    else if (flag == "--model") model = value();
-    else if (flag == "--track") track_name = value();
-    else if (flag == "--speed") speed = number(flag, value());
-    else if (flag == "--rate") loop_settings.rate_hz = number(flag, value());
-    else if (flag == "--samples") options.num_samples = static_cast<int>(number(flag, value()));
-    else if (flag == "--horizon") options.horizon = static_cast<int>(number(flag, value()));
-    else if (flag == "--threads") options.num_threads = static_cast<int>(number(flag, value()));
-    else if (flag == "--seed") options.seed = static_cast<std::uint64_t>(number(flag, value()));
-    else if (flag == "--duration") duration_s = number(flag, value());
-    else if (flag == "--param-port") param_port = static_cast<int>(number(flag, value()));
-    else usage_error("unknown option " + flag);
-  }
+  CLI::App app{"The stack end of the UDP chassis interface: MPPI at a fixed rate on a chassis' state datagrams "
+               "(docs/CHASSIS.md).",
+               "mppi-udp-drive"};
+  cli::configure(app);
+  app.add_option("--host", host, "chassis address")->type_name("ADDR");
+  app.add_option("--port", port, "chassis UDP port")->type_name("N")->check(CLI::Range(0, 65535).description(""));
+  app.add_option("--name", name, "controller name in the priorities")->type_name("NAME");
+  app.add_option("--runstop-name", runstop_name, "runstop source name")->type_name("NAME");
+  cli::add_model_option(app, "--model", model, "controller model (its default data file)");
+  cli::add_track_option(app, track_name, "track of the cost map");
+  app.add_option("--speed", speed, "target speed [m/s]")->type_name("MPS");
+  app.add_option("--rate", loop_settings.rate_hz, "controller rate [Hz]")
+      ->type_name("HZ")
+      ->check(CLI::PositiveNumber.description(""));
+  app.add_option("--samples", options.num_samples, "MPPI samples")->type_name("K");
+  app.add_option("--horizon", options.horizon, "MPPI time steps")->type_name("T");
+  cli::add_threads_option(app, options.num_threads);
+  cli::add_seed_option(app, options.seed);
+  app.add_option("--duration", duration_s, "stop after S seconds; 0 = until Ctrl-C")->type_name("S");
+  app.add_option("--param-port", param_port, "UDP port for parameter messages, 0 = off")
+      ->type_name("N")
+      ->check(CLI::Range(0, 65535).description(""));
+  if (const int rc = cli::parse(app, argc, argv); rc >= 0) return rc;
   try {
     const sim::Track track = sim::Track::load(track_name);
     AutoRallyCostParams cost_params = load_autorally_cost_params(sim::data_file("config/autorally_cost.yaml"));
@@ -106,7 +77,6 @@ int main(int argc, char** argv) {
     // Any registered model with its default data; it reads the chassis' common states.
     std::unique_ptr<Controller> controller;
     std::function<void(const float* common, float* model_x)> observe;
-    if (!is_registered_model(model)) usage_error("unknown model '" + model + "' (valid: " + model_names() + ")");
     with_model(model, [&]<class D>() {
       const std::string default_file = D::kDefaultFile;
       const typename D::Model m = D::load(default_file.empty() ? default_file : sim::data_file(default_file));
