@@ -16,13 +16,14 @@ int FitCommands::run() const {
       return mppi::cli::kUsageExit;
     }
   }
-  return mppi::cli::kUsageExit;  // not reached: a command is required
+  std::fprintf(stderr, "mppi-fit: a command is required\nRun with --help for more information.\n");
+  return mppi::cli::kUsageExit;
 }
 
 int main(int argc, char** argv) {
   CLI::App app{"Parameter estimation and sim-vs-real tools (mppi-fit <command> --help for its options).", "mppi-fit"};
   mppi::cli::configure(app);
-  app.require_subcommand(1);
+  // (the command is required by FitCommands::run, so that an unknown flag is named first)
   FitCommands commands;
   add_estimate_command(app, commands);
   add_convert_command(app, commands);
