@@ -1,7 +1,9 @@
 // mppi-fit: parameter estimation and sim-vs-real tools; dispatches to a subcommand.
 #include <cstdio>
+#include <string>
 
 #include "cli/app.hpp"
+#include "cli/options.hpp"
 #include "mppi_fit_commands.hpp"
 
 int FitCommands::run() const {
@@ -24,6 +26,8 @@ int main(int argc, char** argv) {
   CLI::App app{"Parameter estimation and sim-vs-real tools (mppi-fit <command> --help for its options).", "mppi-fit"};
   mppi::cli::configure(app);
   // (the command is required by FitCommands::run, so that an unknown flag is named first)
+  std::string data_dir;
+  mppi::cli::add_data_dir_option(app, data_dir);  // before the command: mppi-fit --data-dir DIR estimate ...
   FitCommands commands;
   add_estimate_command(app, commands);
   add_convert_command(app, commands);

@@ -1,6 +1,7 @@
 #include "cli/options.hpp"
 
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 
 #include "dynamics/model_registry.hpp"
@@ -55,7 +56,9 @@ CLI::Option* add_out_option(CLI::App& app, std::string& out, const std::string& 
 }
 
 CLI::Option* add_threads_option(CLI::App& app, int& threads) {
-  return app.add_option("--threads", threads, "CPU threads, 0 = all")->type_name("N")->check(CLI::NonNegativeNumber.description(""));
+  return app.add_option("--threads", threads, "CPU threads, 0 = all")
+      ->type_name("N")
+      ->check(CLI::Range(0, std::numeric_limits<int>::max()).description(""));
 }
 
 CLI::Option* add_backend_option(CLI::App& app, BackendChoice& backend) {

@@ -51,6 +51,8 @@ int main(int argc, char** argv) {
   cli::add_track_option(app, track_name, "track the simulated car starts on");
   app.add_option("--duration", duration_s, "stop after S seconds; 0 = until Ctrl-C")->type_name("S");
   app.add_flag("--quiet", quiet, "no status line per second");
+  std::string data_dir;
+  cli::add_data_dir_option(app, data_dir);
   if (const int rc = cli::parse(app, argc, argv); rc >= 0) return rc;
   try {
     const Calibration calibration = Calibration::load_yaml(

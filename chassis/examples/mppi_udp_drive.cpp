@@ -67,6 +67,8 @@ int main(int argc, char** argv) {
   app.add_option("--param-port", param_port, "UDP port for parameter messages, 0 = off")
       ->type_name("N")
       ->check(CLI::Range(0, 65535).description(""));
+  std::string data_dir;
+  cli::add_data_dir_option(app, data_dir);
   if (const int rc = cli::parse(app, argc, argv); rc >= 0) return rc;
   try {
     const sim::Track track = sim::Track::load(track_name);
