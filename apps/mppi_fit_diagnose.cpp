@@ -76,26 +76,34 @@ void add_driver_speed_options(CLI::App& cmd, SynthOptions& o) {
 }
 
 struct DiagnoseArgs {
-  std::string log, params, validate, model = mppi::models::SingleTrackModel::kName, effects;
+  std::vector<std::string> logs, validates;
+  std::string params, model = mppi::models::SingleTrackModel::kName, effects;
   DiagnoseOptions o;
   bool no_plots = false;
   DiagnoseArgs() { o.out_dir = "out/diagnose"; }
 };
 
 int cmd_diagnose(DiagnoseArgs& args) {
-  const std::string &log = args.log, &params = args.params, &validate = args.validate, &model = args.model;
+  const std::string &params = args.params, &model = args.model;
   DiagnoseOptions o = args.o;
   o.selection.candidates = split_list(args.effects);
   o.plots = !args.no_plots;
-  if (log.empty()) throw usage_error("--log", "a recording (--log FILE) is required");
+  if (args.logs.empty()) throw usage_error("--log", "a recording (--log FILE) is required");
   for (const auto& id : o.selection.candidates) effect_spec(id);  // throws for unknown ids
   const auto nominal = make_model_family(model, params);  // throws for other models, bad files
   o.params_source = params;
-  DiagData d = load_any(log);
-  if (!validate.empty()) {  // fit on --log, judge on --validate
-    const std::size_t first = d.rows();
-    d = concat(d, load_any(validate));
-    o.holdout = std::to_string(d.t[first] - 1e-6) + ":" + std::to_string(d.t.back() + 1.0);
+  // Several recordings are fitted jointly (concatenated as separate pieces); every --validate
+  // recording is held out and scored on its own.
+  DiagData d = load_any(args.logs[0]);
+  for (std::size_t i = 1; i < args.logs.size(); ++i) d = concat(d, load_any(args.logs[i]));
+  if (!args.validates.empty()) {  // fit on --log, judge on --validate
+    const double first_t = d.t.back() + 5.0;  // concat leaves a 10 s gap before the next recording
+    for (const auto& v : args.validates) {
+      const std::size_t first = d.rows();
+      d = concat(d, load_any(v));
+      o.heldout_recordings.push_back({v, d.t[first] - 1e-6, d.t.back() + 1e-6});
+    }
+    o.holdout = std::to_string(first_t) + ":" + std::to_string(d.t.back() + 1.0);
   }
   const DiagnoseResult r = run_diagnosis(d, *nominal, o);
   std::printf("mismatch (strongest first):\n");
@@ -109,6 +117,8 @@ int cmd_diagnose(DiagnoseArgs& args) {
   for (const auto& s : r.selection.suspected) std::printf("  suspected %s: %s\n", s.id.c_str(), s.reason.c_str());
   for (const auto& p : r.selection.final_params)
     std::printf("  %s = %.4g +- %.2g %s\n", p.name.c_str(), p.value, p.stddev, p.unit.c_str());
+  for (const auto& p : r.per_recording)
+    std::printf("  held out %s: %.4f -> %.4f\n", p.name.c_str(), p.before, p.after);
   std::printf("held-out normalised RMSE at 1 s: %.4f -> %.4f (%.1f %% reduction)\nreport: %s/report.md\n",
               r.headline_before, r.headline_after, 100 * r.heldout_rmse_reduction, o.out_dir.c_str());
   return 0;
@@ -311,9 +321,9 @@ std::function<int()> guarded(std::shared_ptr<Args> args, int (*run)(Args&)) {
 }
 
 void add_diagnose_options(CLI::App& cmd, DiagnoseArgs& a) {
-  cmd.add_option("--log", a.log,
+  cmd.add_option("--log", a.logs,
                  "recording (docs/RECORDING_FORMAT.md), or a real recording (DART / ETH CSV, or "
-                 "ARCHIVE.zip:MEMBER.csv), converted on the fly (sysid/real_data.hpp)")
+                 "ARCHIVE.zip:MEMBER.csv), converted on the fly (sysid/real_data.hpp); repeat to fit several jointly")
       ->type_name("FILE");
   mppi::cli::add_model_option(cmd, "--model", a.model, "nominal model", nominal_models());
   cmd.add_option("--params", a.params,
@@ -321,7 +331,8 @@ void add_diagnose_options(CLI::App& cmd, DiagnoseArgs& a) {
                  "(default: the library defaults, e.g. data/config/autorally_single_track.yaml)")
       ->type_name("FILE");
   cmd.add_option("--holdout", a.o.holdout, "held-out fraction at the end, or time range T0:T1 [s]")->type_name("H");
-  cmd.add_option("--validate", a.validate, "fit on all of --log, judge on this other recording (replaces --holdout)")
+  cmd.add_option("--validate", a.validates,
+                 "fit on all of --log, judge on this other recording (replaces --holdout); repeat for a cross-recording table")
       ->type_name("FILE");
   cmd.add_option("--effects", a.effects, "candidate effect ids (default: all)")->type_name("A,B,...");
   cmd.add_option("--max-effects", a.o.selection.max_effects, "at most N effects named")->type_name("N");

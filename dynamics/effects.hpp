@@ -23,6 +23,8 @@
 //             steer_backlash              play of width b between servo and wheels
 //   chassis:  tire_saturation             Magic Formula peak D -> k D, B -> s B / k
 //             friction_change             grip (D, Sv) x g from time t_change on
+//             grip_patch                  grip x g on a disc of the ground (centre, radius; a
+//                                         smooth edge a quarter of a metre wide)
 //             load_transfer               CG height h -> h + dh (pitch load transfer)
 //             payload                     mass x m, yaw inertia x j
 //             motor_speed                 no-load speed x v (the motor's torque-speed line)
@@ -81,6 +83,10 @@ struct EffectParams {
   double gyro_bias_radps = 0.0;      // [rad/s] measured yaw rate = r + b
   double speed_scale = 1.0;          // [-] measured vx, vy = s x true
   double time_offset_s = 0.0;        // [s] states stamped late against the commands
+  double patch_x_m = 0.0;            // [m] centre of the grip patch (world frame)
+  double patch_y_m = 0.0;            // [m]
+  double patch_radius_m = 0.0;       // [m] radius of the grip patch
+  double patch_grip_scale = 1.0;     // [-] grip factor on the patch (1 = no patch)
 
   bool is_valid(std::string* why) const;
 };
@@ -114,13 +120,22 @@ enum class Excitation {
   kBraking,     // longitudinal acceleration and braking (pitch load transfer)
 };
 
+// Leading parameters that a fit searches over the data instead of fitting them by least squares
+// (they move where an effect acts, and the cost is flat far from the right value).
+enum class DataGrid {
+  kNone,
+  kTime,   // params[0] is a time within the recording
+  kPlace,  // params[0], params[1] are a place (x, y) the car visited
+};
+inline int grid_param_count(DataGrid g) { return g == DataGrid::kTime ? 1 : g == DataGrid::kPlace ? 2 : 0; }
+
 struct EffectSpec {
   std::string id;               // effect id, e.g. "steer_delay"
   std::string description;      // one line, physical meaning
   EffectHook hook;
   std::vector<EffectParamSpec> params;
   std::vector<double> grid;     // start values searched for params[0] (empty: its default)
-  bool time_grid = false;       // params[0] is a time searched over the data (not LM-fitted)
+  DataGrid data_grid = DataGrid::kNone;  // leading params searched over the data (not LM-fitted)
   Excitation needs = Excitation::kAny;
 };
 
@@ -133,64 +148,69 @@ inline const std::vector<EffectSpec>& effect_table() {
                      kGrade = open(-0.5, 0.5);
   static const std::vector<EffectSpec> table = {
       {"aero_drag", "extra air drag F = -c vx|vx|", H::kForce,
-       {{"aero_drag_kgpm", &E::aero_drag_kgpm, "N s^2/m^2", kAny, -0.05, 3.0, 0.1}}, {}, false, X::kSpeedRange},
+       {{"aero_drag_kgpm", &E::aero_drag_kgpm, "N s^2/m^2", kAny, -0.05, 3.0, 0.1}}, {}, DataGrid::kNone, X::kSpeedRange},
       {"rolling_resistance", "extra rolling resistance F = -(F0 tanh(vx/0.5) + b vx)", H::kForce,
        {{"rolling_force_N", &E::rolling_force_N, "N", kAny, -10.0, 60.0, 2.0},
-        {"rolling_viscous_Nspm", &E::rolling_viscous_Nspm, "N s/m", kAny, -5.0, 30.0, 1.0}}, {}, false, X::kSpeedRange},
+        {"rolling_viscous_Nspm", &E::rolling_viscous_Nspm, "N s/m", kAny, -5.0, 30.0, 1.0}}, {}, DataGrid::kNone, X::kSpeedRange},
       {"steer_delay", "pure delay of the steering command", H::kActuator,
-       {{"steer_delay_s", &E::steer_delay_s, "s", kNonNeg, 0.0, 0.4, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25}, false, X::kSteer},
+       {{"steer_delay_s", &E::steer_delay_s, "s", kNonNeg, 0.0, 0.4, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25}, DataGrid::kNone, X::kSteer},
       {"throttle_delay", "pure delay of the throttle command", H::kActuator,
        {{"throttle_delay_s", &E::throttle_delay_s, "s", kNonNeg, 0.0, 0.4, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25},
-       false, X::kThrottle},
+       DataGrid::kNone, X::kThrottle},
       {"steer_lag", "first-order steering actuator", H::kActuator,
-       {{"steer_lag_s", &E::steer_lag_s, "s", kNonNeg, 0.0, 0.6, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25}, false, X::kSteer},
+       {{"steer_lag_s", &E::steer_lag_s, "s", kNonNeg, 0.0, 0.6, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25}, DataGrid::kNone, X::kSteer},
       {"throttle_lag", "first-order throttle / motor response", H::kActuator,
-       {{"throttle_lag_s", &E::throttle_lag_s, "s", kNonNeg, 0.0, 1.0, 0.05}}, {0.03, 0.06, 0.1, 0.2, 0.4}, false, X::kThrottle},
+       {{"throttle_lag_s", &E::throttle_lag_s, "s", kNonNeg, 0.0, 1.0, 0.05}}, {0.03, 0.06, 0.1, 0.2, 0.4}, DataGrid::kNone, X::kThrottle},
       {"steer_offset", "steering bias (trim)", H::kActuator,
-       {{"steer_offset", &E::steer_offset, "1 (normalised steer)", kAny, -0.4, 0.4, 0.02}}, {}, false, X::kAny},
+       {{"steer_offset", &E::steer_offset, "1 (normalised steer)", kAny, -0.4, 0.4, 0.02}}, {}, DataGrid::kNone, X::kAny},
       {"steer_gain", "steering scale (servo / linkage gain)", H::kActuator,
-       {{"steer_gain", &E::steer_gain, "1", kAny, 0.3, 2.0, 0.1}}, {0.7, 1.0, 1.3}, false, X::kSteer},
+       {{"steer_gain", &E::steer_gain, "1", kAny, 0.3, 2.0, 0.1}}, {0.7, 1.0, 1.3}, DataGrid::kNone, X::kSteer},
       {"throttle_offset", "throttle bias / motor dead band", H::kActuator,
-       {{"throttle_offset", &E::throttle_offset, "1 (normalised throttle)", kAny, -0.4, 0.4, 0.02}}, {}, false, X::kThrottle},
+       {{"throttle_offset", &E::throttle_offset, "1 (normalised throttle)", kAny, -0.4, 0.4, 0.02}}, {}, DataGrid::kNone, X::kThrottle},
       {"tire_saturation", "tyre friction limit (Pacejka peak D x k) and cornering stiffness (x s)", H::kChassis,
        {{"tyre_peak_scale", &E::tyre_peak_scale, "1", kScale, 0.3, 3.0, 0.1},
-        {"tyre_stiffness_scale", &E::tyre_stiffness_scale, "1", kScale, 0.2, 5.0, 0.1}}, {0.6, 1.0, 1.4}, false, X::kCornering},
+        {"tyre_stiffness_scale", &E::tyre_stiffness_scale, "1", kScale, 0.2, 5.0, 0.1}}, {0.6, 1.0, 1.4}, DataGrid::kNone, X::kCornering},
       {"friction_change", "grip (whole friction curve) x g from time t_change on", H::kChassis,
        {{"grip_change_time_s", &E::grip_change_time_s, "s", kAny, 0.0, 1e9, 1.0},
-        {"grip_scale", &E::grip_scale, "1", kScale, 0.3, 3.0, 0.1}}, {}, true, X::kCornering},
+        {"grip_scale", &E::grip_scale, "1", kScale, 0.3, 3.0, 0.1}}, {}, DataGrid::kTime, X::kCornering},
+      {"grip_patch", "grip (whole friction curve) x g on a disc of the ground: a patch of other surface", H::kChassis,
+       {{"patch_x_m", &E::patch_x_m, "m", kAny, -1e9, 1e9, 1.0},
+        {"patch_y_m", &E::patch_y_m, "m", kAny, -1e9, 1e9, 1.0},
+        {"patch_radius_m", &E::patch_radius_m, "m", kNonNeg, 0.0, 30.0, 0.5},
+        {"patch_grip_scale", &E::patch_grip_scale, "1", kScale, 0.3, 3.0, 0.1}}, {}, DataGrid::kPlace, X::kCornering},
       {"load_transfer", "pitch load transfer: CG height h + dh", H::kChassis,
-       {{"cg_height_delta_m", &E::cg_height_delta_m, "m", kAny, -0.115, 0.12, 0.02}}, {}, false, X::kBraking},
+       {{"cg_height_delta_m", &E::cg_height_delta_m, "m", kAny, -0.115, 0.12, 0.02}}, {}, DataGrid::kNone, X::kBraking},
       {"motor_voltage_sag", "drive falls with current: throttle u - k max(u,0)^2", H::kActuator,
-       {{"voltage_sag", &E::voltage_sag, "1", {0.0, 1.0, Bounds::kOpenHigh}, 0.0, 0.9, 0.05}}, {}, false, X::kThrottle},
+       {{"voltage_sag", &E::voltage_sag, "1", {0.0, 1.0, Bounds::kOpenHigh}, 0.0, 0.9, 0.05}}, {}, DataGrid::kNone, X::kThrottle},
       {"road_grade", "tilted ground plane z = gx x + gy y", H::kForce,
        {{"grade_x", &E::grade_x, "1 (dz/dx)", kGrade, -0.3, 0.3, 0.01},
-        {"grade_y", &E::grade_y, "1 (dz/dy)", kGrade, -0.3, 0.3, 0.01}}, {}, false, X::kAny},
+        {"grade_y", &E::grade_y, "1 (dz/dy)", kGrade, -0.3, 0.3, 0.01}}, {}, DataGrid::kNone, X::kAny},
       {"throttle_gain", "motor / ESC gain: throttle u -> g u", H::kActuator,
-       {{"throttle_gain", &E::throttle_gain, "1", kScale, 0.3, 2.5, 0.1}}, {0.7, 1.0, 1.4}, false, X::kThrottle},
+       {{"throttle_gain", &E::throttle_gain, "1", kScale, 0.3, 2.5, 0.1}}, {0.7, 1.0, 1.4}, DataGrid::kNone, X::kThrottle},
       {"steer_cubic", "nonlinear steering linkage: s -> s + k s^3", H::kActuator,
-       {{"steer_cubic", &E::steer_cubic, "1", open(-1.0, 2.0), -0.6, 1.0, 0.1}}, {-0.3, 0.3}, false, X::kSteer},
+       {{"steer_cubic", &E::steer_cubic, "1", open(-1.0, 2.0), -0.6, 1.0, 0.1}}, {-0.3, 0.3}, DataGrid::kNone, X::kSteer},
       {"steer_asymmetry", "left and right steering gains differ: x (1 + a) left, x (1 - a) right", H::kActuator,
-       {{"steer_asymmetry", &E::steer_asymmetry, "1", open(-0.9, 0.9), -0.4, 0.4, 0.05}}, {}, false, X::kSteer},
+       {{"steer_asymmetry", &E::steer_asymmetry, "1", open(-0.9, 0.9), -0.4, 0.4, 0.05}}, {}, DataGrid::kNone, X::kSteer},
       {"steer_rate_limit", "steering servo speed: the applied steer needs T seconds per unit of change", H::kActuator,
        {{"steer_slew_s", &E::steer_slew_s, "s (per unit of normalised steer)", kNonNeg, 0.0, 3.0, 0.05}},
-       {0.1, 0.3, 0.8}, false, X::kSteer},
+       {0.1, 0.3, 0.8}, DataGrid::kNone, X::kSteer},
       {"throttle_rate_limit", "throttle ramp: the applied throttle needs T seconds per unit of change", H::kActuator,
        {{"throttle_slew_s", &E::throttle_slew_s, "s (per unit of normalised throttle)", kNonNeg, 0.0, 3.0, 0.05}},
-       {0.1, 0.3, 0.8}, false, X::kThrottle},
+       {0.1, 0.3, 0.8}, DataGrid::kNone, X::kThrottle},
       {"steer_backlash", "play of width b between the steering servo and the wheels", H::kActuator,
        {{"steer_backlash", &E::steer_backlash, "1 (normalised steer)", closed(0.0, 0.5), 0.0, 0.3, 0.02}},
-       {0.02, 0.05, 0.1}, false, X::kSteer},
+       {0.02, 0.05, 0.1}, DataGrid::kNone, X::kSteer},
       {"payload", "mass and yaw inertia differ from the nominal (payload, battery)", H::kChassis,
        {{"mass_scale", &E::mass_scale, "1", kScale, 0.5, 2.5, 0.1},
-        {"yaw_inertia_scale", &E::yaw_inertia_scale, "1", kScale, 0.5, 2.5, 0.1}}, {0.8, 1.2, 1.5}, false, X::kThrottle},
+        {"yaw_inertia_scale", &E::yaw_inertia_scale, "1", kScale, 0.5, 2.5, 0.1}}, {0.8, 1.2, 1.5}, DataGrid::kNone, X::kThrottle},
       {"motor_speed", "the drivetrain's torque-speed line: no-load speed x v", H::kChassis,
-       {{"motor_speed_scale", &E::motor_speed_scale, "1", kScale, 0.3, 3.0, 0.1}}, {0.6, 1.0, 1.5}, false, X::kSpeedRange},
+       {{"motor_speed_scale", &E::motor_speed_scale, "1", kScale, 0.3, 3.0, 0.1}}, {0.6, 1.0, 1.5}, DataGrid::kNone, X::kSpeedRange},
       {"gyro_bias", "sensor fault: the yaw-rate gyro reads r + b", H::kSensor,
-       {{"gyro_bias_radps", &E::gyro_bias_radps, "rad/s", kAny, -0.5, 0.5, 0.01}}, {}, false, X::kAny},
+       {{"gyro_bias_radps", &E::gyro_bias_radps, "rad/s", kAny, -0.5, 0.5, 0.01}}, {}, DataGrid::kNone, X::kAny},
       {"speed_sensor_scale", "sensor fault: the velocity sensor reads s x (vx, vy)", H::kSensor,
-       {{"speed_scale", &E::speed_scale, "1", kScale, 0.5, 1.5, 0.02}}, {}, false, X::kAny},
+       {{"speed_scale", &E::speed_scale, "1", kScale, 0.5, 1.5, 0.02}}, {}, DataGrid::kNone, X::kAny},
       {"time_offset", "sensor fault: states stamped t late against the commands (negative: early)", H::kSensor,
-       {{"time_offset_s", &E::time_offset_s, "s", open(-0.5, 0.5), -0.3, 0.0, 0.01}}, {-0.1, -0.04}, false, X::kSteer},
+       {{"time_offset_s", &E::time_offset_s, "s", open(-0.5, 0.5), -0.3, 0.0, 0.01}}, {-0.1, -0.04}, DataGrid::kNone, X::kSteer},
   };
   return table;
 }

@@ -8,9 +8,10 @@
 // (plus the bookkeeping states). Each effect enters through its hook:
 //   - actuator: offsets, gains, steering map, delays, lags, rate limits, backlash and voltage
 //     sag transform the command first;
-//   - chassis: tire_saturation, friction_change, load_transfer, payload and motor_speed change
-//     the base's single-track core parameters (apply_effect_params), with a second base model
-//     for the grip after a change (time is a state). Only for bases with such a core (the
+//   - chassis: tire_saturation, friction_change, grip_patch, load_transfer, payload and
+//     motor_speed change the base's single-track core parameters (apply_effect_params), with a
+//     second base model for the other grip: after a change (time is a state) or on the patch
+//     (across the patch's edge the two steps are blended). Only for bases with such a core (the
 //     single-track and four-wheel models); the kinematic bicycle and the network have none, so
 //     these are refused;
 //   - force: aero_drag, rolling_resistance and road_grade add an acceleration along the body
@@ -80,7 +81,7 @@ class WithEffects {
   // base does not have.
   explicit WithEffects(const Base& nominal = Base(), const EffectParams& effects = {})
       : nominal_(nominal), effects_(validated(effects)), before_(with_core(nominal, effects, 1.0)),
-        after_(with_core(nominal, effects, effects.grip_scale)) {
+        after_(with_core(nominal, effects, other_grip(effects))) {
     SingleTrackParams car;  // the AutoRally car, for bases without a mass
     if constexpr (kChassisEffects) car = single_track_core(after_.params());  // payload included
     const double m = car.mass_kg, g = car.gravity_mps2;
@@ -91,6 +92,10 @@ class WithEffects {
     grade_y_ = static_cast<float>(g * effects_.grade_y);
     change_time_ = static_cast<float>(effects_.grip_change_time_s);
     grip_changes_ = effects_.grip_scale != 1.0;
+    patch_ = effects_.patch_grip_scale != 1.0;
+    patch_x_ = static_cast<float>(effects_.patch_x_m);
+    patch_y_ = static_cast<float>(effects_.patch_y_m);
+    patch_r_ = static_cast<float>(effects_.patch_radius_m);
     gain_ = static_cast<float>(effects_.steer_gain);
     offset_ = static_cast<float>(effects_.steer_offset);
     steer_cubic_ = static_cast<float>(effects_.steer_cubic);
@@ -146,7 +151,8 @@ class WithEffects {
     const ActuatorCoeffs k = actuator_coeffs(effects_, dt_s);
     float applied[kNu * W];  // the command the base model sees, per lane
     float ax[W], ay[W];      // force hook: body-axis accelerations from the start-of-step state
-    int before_lanes = 0;
+    float other_w[W];        // weight of the other grip (after a change, on the patch) per lane
+    int before_lanes = 0, blended_lanes = 0;
     for (int j = 0; j < W; ++j) {
       float chain_s[kChain], chain_t[kChain];
       for (int i = 0; i < kChain; ++i) {
@@ -167,22 +173,27 @@ class WithEffects {
       ax[j] = -drag_per_kg_ * vx * std::abs(vx) - roll_per_kg_ * phys::tanh(vx * 2.f) - visc_per_kg_ * vx -
               (grade_x_ * cy + grade_y_ * sy);
       ay[j] = -(-grade_x_ * sy + grade_y_ * cy);
-      before_lanes += grip_changes_ && x[kTime][j] < change_time_;
+      other_w[j] = other_grip_weight(x[kTime][j], x[state::kX][j], x[state::kY][j]);
+      before_lanes += other_w[j] == 0.f;
+      blended_lanes += other_w[j] > 0.f && other_w[j] < 1.f;
     }
     const Batch<Base::kNx, W> xb{x.data};
     const ConstBatch<Base::kNu, W> ub{applied};
-    if (before_lanes == 0) {
+    if (before_lanes == 0 && blended_lanes == 0) {
       base_step<W>(after_, xb, ub, dt_s, scratch, ax, ay);
     } else if (before_lanes == W) {
       base_step<W>(before_, xb, ub, dt_s, scratch, ax, ay);
-    } else {  // lanes on both sides of a grip change: step both, keep each lane's own
+    } else {  // lanes on both sides of a grip change or patch edge: step both, blend per lane
       float copy[Base::kNx * W];
       std::copy(x.data, x.data + Base::kNx * W, copy);
       base_step<W>(before_, Batch<Base::kNx, W>{copy}, ub, dt_s, scratch, ax, ay);
       base_step<W>(after_, xb, ub, dt_s, scratch, ax, ay);
-      for (int j = 0; j < W; ++j)
-        if (x[kTime][j] < change_time_)
-          for (int i = 0; i < Base::kNx; ++i) x[i][j] = copy[i * W + j];
+      for (int j = 0; j < W; ++j) {
+        const float w = other_w[j];
+        if (w == 1.f) continue;
+        for (int i = 0; i < Base::kNx; ++i)
+          x[i][j] = w == 0.f ? copy[i * W + j] : w * x[i][j] + (1.f - w) * copy[i * W + j];
+      }
     }
     for (int j = 0; j < W; ++j) x[kTime][j] += dt_s;
   }
@@ -200,6 +211,25 @@ class WithEffects {
   }
 
  private:
+  // Weight of the other grip at this time and place: 0 or 1 for a change in time; on a patch a
+  // logistic edge kPatchEdge_m wide, snapped to 0 / 1 where it is within 1e-3 of them (so the
+  // car steps one base model away from the edge).
+  static constexpr float kPatchEdge_m = 0.25f;
+  float other_grip_weight(float t_s, float x_m, float y_m) const noexcept {
+    if (grip_changes_) return t_s < change_time_ ? 0.f : 1.f;
+    if (!patch_) return 1.f;  // only the nominal grip: after_ == before_
+    const float dx = x_m - patch_x_, dy = y_m - patch_y_;
+    const float z = (std::sqrt(dx * dx + dy * dy) - patch_r_) / kPatchEdge_m;
+    if (z > 6.9f) return 0.f;
+    if (z < -6.9f) return 1.f;
+    return 1.f / (1.f + std::exp(z));
+  }
+  static double other_grip(const EffectParams& e) {
+    if (e.grip_scale != 1.0 && e.patch_grip_scale != 1.0)
+      throw Error("WithEffects: friction_change and grip_patch cannot be combined (one other grip)");
+    return e.patch_grip_scale != 1.0 ? e.patch_grip_scale : e.grip_scale;
+  }
+
   // One base step with the force hook: inside the base's force balance where it offers that,
   // else added after its step.
   template <int W>
@@ -244,7 +274,8 @@ class WithEffects {
   EffectParams effects_;
   Base before_, after_;
   float drag_per_kg_ = 0, roll_per_kg_ = 0, visc_per_kg_ = 0, grade_x_ = 0, grade_y_ = 0, change_time_ = 0;
-  bool grip_changes_ = false;
+  bool grip_changes_ = false, patch_ = false;
+  float patch_x_ = 0, patch_y_ = 0, patch_r_ = 0;
   float gain_ = 1, offset_ = 0, steer_cubic_ = 0, left_gain_ = 1, right_gain_ = 1;  // steering map
   float throttle_gain_ = 1, thr_offset_ = 0, sag_ = 0;                              // throttle map
 };

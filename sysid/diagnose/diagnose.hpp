@@ -23,6 +23,13 @@ struct DiagnoseOptions {
   ReplayOptions replay;
   bool plots = true;
   std::string params_source;            // nominal parameter file, for the report
+  // Held-out recordings by name and time span (after concat): each gets its own before/after
+  // line in the cross-recording table.
+  struct Part {
+    std::string name;
+    double t0_s = 0, t1_s = 0;
+  };
+  std::vector<Part> heldout_recordings;
 };
 
 struct DiagnoseResult {
@@ -31,6 +38,18 @@ struct DiagnoseResult {
   std::vector<HorizonMetrics> before, after;  // held out: one-step first, then options.horizons_s
   double headline_before = 0, headline_after = 0;  // normalised RMSE at the headline horizon
   double heldout_rmse_reduction = 0;          // 1 - after / before at the headline horizon
+  // Share of the held-out squared error at the headline horizon that the correction removes,
+  // per channel (1 - (RMSE after / before)^2), and where the rest sits (the corrected model's
+  // residuals located on the held-out part, strongest first).
+  double explained_share[kChannels] = {0, 0, 0};
+  std::vector<Mismatch> remaining;
+  // Per held-out recording (DiagnoseOptions::heldout_recordings): normalised RMSE at the
+  // headline horizon, nominal and corrected.
+  struct PartScore {
+    std::string name;
+    double before = 0, after = 0;
+  };
+  std::vector<PartScore> per_recording;
   std::string model_file;
   std::string json;                           // report.json text
 };

@@ -32,7 +32,82 @@ double residuals(const FitProblem& p, const EffectParams& e, std::vector<double>
   return r->empty() ? 0.0 : s / static_cast<double>(r->size());
 }
 
+// Places the car visited in the problem's segments, spread out: farthest-point sampling.
+std::vector<std::pair<double, double>> spread_places(const FitProblem& p, int count) {
+  std::vector<std::pair<double, double>> visited;
+  for (const auto& s : p.segments)
+    for (int k = 0; k <= s.len; k += 5) visited.emplace_back(p.data->x[s.start + static_cast<std::size_t>(k)],
+                                                             p.data->y[s.start + static_cast<std::size_t>(k)]);
+  std::vector<std::pair<double, double>> chosen;
+  if (visited.empty()) return chosen;
+  std::vector<double> d2(visited.size(), std::numeric_limits<double>::infinity());
+  std::size_t next = 0;
+  for (int c = 0; c < count; ++c) {
+    chosen.push_back(visited[next]);
+    double far = -1;
+    for (std::size_t i = 0; i < visited.size(); ++i) {
+      const double dx = visited[i].first - chosen.back().first, dy = visited[i].second - chosen.back().second;
+      d2[i] = std::min(d2[i], dx * dx + dy * dy);
+      if (d2[i] > far) {
+        far = d2[i];
+        next = i;
+      }
+    }
+    if (far <= 0) break;  // every visited place is chosen
+  }
+  return chosen;
+}
+
 }  // namespace
+
+// A place-dependent effect (params: x, y, then the rest): its leading parameters are searched
+// over places the car visited with a few sizes and strengths of the rest, then the best starts
+// are refined by least squares in all parameters (the effect's edge is smooth).
+FitResult fit_place_effect(const FitProblem& p, const EffectParams& base, const EffectSpec& spec) {
+  constexpr int kPlaces = 16, kStarts = 2;
+  const EffectParamSpec& px = spec.params[0];
+  const EffectParamSpec& py = spec.params[1];
+  struct Start {
+    double cost;
+    EffectParams e;
+  };
+  std::vector<Start> starts;
+  for (const auto& [x, y] : spread_places(p, kPlaces)) {
+    // The other parameters at a small and a large value on each side of their default.
+    std::vector<EffectParams> variants(1, base);
+    for (std::size_t i = 2; i < spec.params.size(); ++i) {
+      const EffectParamSpec& q = spec.params[i];
+      const double d = base.*(q.member);
+      std::vector<EffectParams> next;
+      for (const EffectParams& v : variants)
+        for (double f : {0.25, 0.6}) {
+          EffectParams e = v;
+          // a size (from the default 0: a fraction of the range's top) or a strength (below and above 1)
+          e.*(q.member) = d == 0.0 ? q.lo + f * 0.4 * (q.hi - q.lo) : (f < 0.5 ? d * 0.6 : d * 1.6);
+          e.*(q.member) = std::clamp(e.*(q.member), q.lo, q.hi);
+          next.push_back(e);
+        }
+      variants.swap(next);
+    }
+    for (EffectParams& e : variants) {
+      e.*(px.member) = x;
+      e.*(py.member) = y;
+      starts.push_back({mean_cost(p, e), e});
+    }
+  }
+  std::sort(starts.begin(), starts.end(), [](const Start& a, const Start& b) { return a.cost < b.cost; });
+  FitResult best;
+  best.cost = std::numeric_limits<double>::infinity();
+  best.effects = base;
+  for (std::size_t s = 0; s < starts.size() && s < kStarts; ++s) {
+    if (!std::isfinite(starts[s].cost)) break;
+    FitResult r = fit_params(p, starts[s].e, spec.params, 10);
+    if (r.cost < best.cost) best = r;
+  }
+  if (best.params.empty())
+    for (const EffectParamSpec& q : spec.params) best.params.push_back({q.name, q.unit, base.*(q.member), 0.0});
+  return best;
+}
 
 double mean_cost(const FitProblem& p, const EffectParams& e) {
   std::vector<double> r;
@@ -118,7 +193,7 @@ FitResult fit_params(const FitProblem& p, const EffectParams& base, const std::v
 }
 
 FitResult fit_effect(const FitProblem& p, const EffectParams& base, const EffectSpec& spec) {
-  if (spec.time_grid) {
+  if (spec.data_grid == DataGrid::kTime) {
     // params[0] is a time: grid over the training span, LM on the rest at each; keep the best.
     double t0 = 1e18, t1 = -1e18;
     for (const auto& s : p.segments) {
@@ -142,6 +217,7 @@ FitResult fit_effect(const FitProblem& p, const EffectParams& base, const Effect
     }
     return best;
   }
+  if (spec.data_grid == DataGrid::kPlace) return fit_place_effect(p, base, spec);
   EffectParams start = base;
   if (!spec.grid.empty()) {
     double best = std::numeric_limits<double>::infinity();

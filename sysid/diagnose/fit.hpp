@@ -46,6 +46,9 @@ struct FitResult {
 FitResult fit_params(const FitProblem& p, const EffectParams& base, const std::vector<ParamSpec>& free,
                      int max_iterations = 15);
 
+// A place-dependent effect (grip_patch): its place searched over where the car went, then LM.
+FitResult fit_place_effect(const FitProblem& p, const EffectParams& base, const EffectSpec& spec);
+
 // One effect (spec) on top of base: start-value grid search, then LM.
 FitResult fit_effect(const FitProblem& p, const EffectParams& base, const EffectSpec& spec);
 

@@ -98,7 +98,7 @@ std::string excitation_shortfall(Excitation needs, const ExcitationLevels& x) {
 std::string range_limit_shortfall(const EffectSpec& spec, const EffectParams& fitted, double margin) {
   const EffectParams defaults;
   for (std::size_t i = 0; i < spec.params.size(); ++i) {
-    if (spec.time_grid && i == 0) continue;  // a time searched over the data, not a bound
+    if (static_cast<int>(i) < grid_param_count(spec.data_grid)) continue;  // searched over the data, not bounded
     const EffectParamSpec& p = spec.params[i];
     const double v = fitted.*(p.member), d = defaults.*(p.member), tol = margin * (p.hi - p.lo);
     const bool at_lo = v <= p.lo + tol && std::abs(d - p.lo) > tol;

@@ -100,6 +100,48 @@ std::pair<std::size_t, double> best_split(const std::vector<double>& x, std::siz
   return best;
 }
 
+struct PlaceCell {
+  double x0, x1, y0, y1;
+  BinStat stat;
+};
+std::vector<PlaceCell> place_cells(const DiagData& d, const std::vector<double>& resid, const std::vector<char>& mask,
+                                   double spi) {
+  constexpr int kCells = 4;
+  double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+  for (std::size_t k = 0; k < resid.size(); ++k)
+    if (std::isfinite(resid[k]) && (mask.empty() || mask[k])) {
+      x0 = std::min(x0, d.x[k]);
+      x1 = std::max(x1, d.x[k]);
+      y0 = std::min(y0, d.y[k]);
+      y1 = std::max(y1, d.y[k]);
+    }
+  std::vector<PlaceCell> out;
+  if (!(x1 > x0 && y1 > y0)) return out;
+  const double wx = (x1 - x0) / kCells, wy = (y1 - y0) / kCells;
+  double sum[kCells][kCells] = {}, sum2[kCells][kCells] = {};
+  int n[kCells][kCells] = {};
+  for (std::size_t k = 0; k < resid.size(); ++k) {
+    if (!std::isfinite(resid[k]) || (!mask.empty() && !mask[k])) continue;
+    const int i = std::min(kCells - 1, static_cast<int>((d.x[k] - x0) / wx));
+    const int j = std::min(kCells - 1, static_cast<int>((d.y[k] - y0) / wy));
+    sum[i][j] += resid[k];
+    sum2[i][j] += resid[k] * resid[k];
+    ++n[i][j];
+  }
+  for (int i = 0; i < kCells; ++i)
+    for (int j = 0; j < kCells; ++j) {
+      if (n[i][j] < 50) continue;  // a cell the car barely visited says nothing
+      PlaceCell c{x0 + i * wx, x0 + (i + 1) * wx, y0 + j * wy, y0 + (j + 1) * wy, {}};
+      c.stat.n = n[i][j];
+      c.stat.mean = sum[i][j] / n[i][j];
+      c.stat.rms = std::sqrt(sum2[i][j] / n[i][j]);
+      const double sd = std::sqrt(std::max(1e-18, sum2[i][j] / n[i][j] - c.stat.mean * c.stat.mean));
+      c.stat.z = c.stat.mean / (sd / std::sqrt(std::max(1.0, n[i][j] / spi)));
+      out.push_back(c);
+    }
+  return out;
+}
+
 std::string range_text(const char* name, double lo, double hi, const char* unit) {
   char buf[128];
   std::snprintf(buf, sizeof buf, "%s in [%.3g, %.3g] %s", name, lo, hi, unit);
@@ -128,6 +170,15 @@ std::vector<Mismatch> locate(const DiagData& d, const ResidualSeries& res, const
           out.push_back({kChannelNames[c], range_text(kRegimeNames[g], b.lo, b.hi, kRegimeUnits[g]), b.mean,
                          b.rms, b.z, unit});
     }
+    // Places: a 4 x 4 grid over the area the masked rows cover; a cell that stands out is where
+    // the ground (grip, grade) may differ.
+    for (const PlaceCell& cell : place_cells(d, res.e[c], mask, spi))
+      if (std::abs(cell.stat.z) >= min_z && std::abs(cell.stat.mean) >= 0.25 * overall_rms) {
+        char where[160];
+        std::snprintf(where, sizeof where, "place x in [%.3g, %.3g] m, y in [%.3g, %.3g] m", cell.x0, cell.x1, cell.y0,
+                      cell.y1);
+        out.push_back({kChannelNames[c], where, cell.stat.mean, cell.stat.rms, cell.stat.z, unit});
+      }
     // Time windows: binary segmentation of the residual mean, up to 3 levels.
     std::vector<double> x;
     std::vector<std::size_t> rows;

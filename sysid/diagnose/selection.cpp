@@ -83,13 +83,13 @@ GreedyResult greedy(const FitProblem& fit, const FitProblem& val, const std::vec
         if (log) log->push_back("round " + std::to_string(round) + ": " + spec.id + " not identified: " + limit);
         continue;
       }
-      if (spec.time_grid) {
+      if (spec.data_grid == DataGrid::kTime) {
         // A change "from time t on" is also what a place or a state that the car reaches later
         // looks like; the state-dependent explanation wins when it does nearly as well.
         const CandidateFit* rival = nullptr;
         for (const auto& o : tried) {
           const EffectSpec& os = *cands[static_cast<std::size_t>(o.index)];
-          if (os.time_grid || os.hook != EffectHook::kChassis) continue;
+          if (os.data_grid == DataGrid::kTime || os.hook != EffectHook::kChassis) continue;
           if (o.improvement >= opt.time_change_dominance * c->improvement && (!rival || o.improvement > rival->improvement))
             rival = &o;
         }
@@ -271,7 +271,7 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
     for (const auto& id : named) {
       const EffectSpec& s = effect_spec(id);
       for (std::size_t j = 0; j < s.params.size(); ++j) {
-        if (s.time_grid && j == 0) {
+        if (s.data_grid == DataGrid::kTime && j == 0) {
           fixed_times.push_back({s.params[0].name, s.params[0].unit, start.*(s.params[0].member), 0.0});
           for (const auto& c : sel.candidates)
             if (c.id == id && !c.params.empty()) fixed_times.back().stddev = c.params[0].stddev;

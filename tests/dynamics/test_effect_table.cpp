@@ -244,3 +244,51 @@ TEST_CASE("payload and motor speed equal the base model with its mass, inertia a
   CHECK(max_difference_after(SingleTrack(heavy), CorrectedSingleTrack(SingleTrack(), e), u, u, 500) < 1e-5f);
   CHECK(max_difference_after(SingleTrack(), CorrectedSingleTrack(SingleTrack(), e), u, u, 500) > 1e-2f);
 }
+
+TEST_CASE("a grip patch is the base model with the friction curve scaled on the patch only", "[effects]") {
+  SingleTrackParams slippery;  // the friction curve (peak and vertical shift) x 0.5
+  slippery.tyre.D *= 0.5;
+  slippery.tyre.Sv *= 0.5;
+  const float u[2] = {0.3f, 0.6f};
+  EffectParams far_away;  // a patch the car never reaches
+  far_away.patch_x_m = 100;
+  far_away.patch_y_m = 100;
+  far_away.patch_radius_m = 3;
+  far_away.patch_grip_scale = 0.5;
+  CHECK(max_difference_after(SingleTrack(), CorrectedSingleTrack(SingleTrack(), far_away), u, u, 500) == 0.f);
+  EffectParams around = far_away;  // a patch the car never leaves
+  around.patch_x_m = 0;
+  around.patch_y_m = 0;
+  around.patch_radius_m = 50;
+  CHECK(max_difference_after(SingleTrack(slippery), CorrectedSingleTrack(SingleTrack(), around), u, u, 500) < 1e-5f);
+  CHECK(max_difference_after(SingleTrack(), CorrectedSingleTrack(SingleTrack(), around), u, u, 500) > 1e-2f);
+
+  // On the patch's edge (distance = radius) the step is the mean of the two grips' steps.
+  EffectParams edge = far_away;
+  edge.patch_x_m = 2;
+  edge.patch_y_m = 0;
+  edge.patch_radius_m = 2;
+  const CorrectedSingleTrack wrapped(SingleTrack(), edge);
+  float xw[CorrectedSingleTrack::kNx], xn[SingleTrack::kNx], xs[SingleTrack::kNx];
+  std::vector<float> scratch(std::max<std::size_t>(1, wrapped.scratch_floats(1)));
+  start(wrapped, xw, 5.f);
+  wrapped.set_actuators(xw, u[0], u[1]);
+  start(SingleTrack(), xn, 5.f);
+  start(SingleTrack(), xs, 5.f);
+  for (int i = 0; i < 3; ++i) {  // a few steps of turning first, so that the grip matters
+    SingleTrack().step<1>(Batch<SingleTrack::kNx, 1>{xn}, ConstBatch<2, 1>{u}, 0.002f, scratch.data());
+  }
+  std::copy(xn, xn + SingleTrack::kNx, xs);
+  std::copy(xn, xn + SingleTrack::kNx, xw);
+  xw[state::kX] = xs[state::kX] = xn[state::kX] = 0.f;
+  xw[state::kY] = xs[state::kY] = xn[state::kY] = 0.f;
+  SingleTrack().step<1>(Batch<SingleTrack::kNx, 1>{xn}, ConstBatch<2, 1>{u}, 0.002f, scratch.data());
+  SingleTrack(slippery).step<1>(Batch<SingleTrack::kNx, 1>{xs}, ConstBatch<2, 1>{u}, 0.002f, scratch.data());
+  wrapped.step<1>(Batch<CorrectedSingleTrack::kNx, 1>{xw}, ConstBatch<2, 1>{u}, 0.002f, scratch.data());
+  for (int i = 0; i < SingleTrack::kNx; ++i) CHECK(xw[i] == Approx(0.5f * (xn[i] + xs[i])).margin(1e-6));
+  CHECK(std::abs(xn[state::kVy] - xs[state::kVy]) + std::abs(xn[state::kYawRate] - xs[state::kYawRate]) > 1e-5f);
+
+  EffectParams both = far_away;  // one other grip at a time
+  both.grip_scale = 0.8;
+  CHECK_THROWS_WITH(CorrectedSingleTrack(SingleTrack(), both), Catch::Contains("cannot be combined"));
+}

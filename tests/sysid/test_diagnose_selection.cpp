@@ -4,6 +4,7 @@
 // `mppi-fit diagnose sweep`, closed loop with MPPI).
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -170,4 +171,77 @@ TEST_CASE("an effect that the held-out part contradicts is not named and no mode
   bool bias_suspected = false;
   for (const auto& s : r.selection.suspected) bias_suspected |= s.id == "gyro_bias";
   CHECK(bias_suspected);
+}
+
+namespace {
+
+// Circles of radius 8 m around the origin, written here independently of the library's effects:
+// two single-track cars, the nominal one and one whose friction curve is halved, and the plant
+// steps the slippery one while the car is on a disc of radius 3 m centred at (8, 0) (a hard
+// edge, where the library's patch has a smooth one). Steering follows the circle with a dither,
+// the speed steps between 4 and 6 m/s; 50 Hz, a little sensor noise.
+sim::Recording circles_over_a_patch(std::uint64_t seed, double duration_s) {
+  SingleTrackParams slippery_params;
+  slippery_params.tyre.D *= 0.5;
+  slippery_params.tyre.Sv *= 0.5;
+  const SingleTrack nominal, slippery(slippery_params);
+  float x[SingleTrack::kNx];
+  VehicleState s0;
+  s0.y_m = -8.f;
+  s0.vx_mps = 4.f;
+  nominal.init_state(s0, x);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.01), dither(0.0, 0.08);
+  sim::Recording rec;
+  rec.columns = {sim::kRecordingRequiredColumns.begin(), sim::kRecordingRequiredColumns.end()};
+  rec.data.assign(rec.columns.size(), {});
+  const int rows = static_cast<int>(duration_s / 0.02);
+  double steer_dither = 0;
+  for (int k = 0; k < rows; ++k) {
+    const double px = x[state::kX], py = x[state::kY];
+    const double radius = std::hypot(px, py);
+    const double tangent = std::atan2(py, px) + M_PI / 2 + 0.6 * (radius - 8.0) / 8.0;
+    const double heading_error = std::remainder(tangent - x[state::kYaw], 2 * M_PI);
+    if (k % 10 == 0) steer_dither = dither(rng);
+    const float steer = static_cast<float>(std::clamp(1.5 * heading_error + 0.45 + steer_dither, -1.0, 1.0));
+    const double target_mps = (k / 250) % 2 == 0 ? 4.0 : 6.0;
+    const float throttle = static_cast<float>(std::clamp(0.3 + 0.5 * (target_mps - x[state::kVx]), -0.5, 0.9));
+    const double row[] = {0.02 * k, px, py, x[state::kYaw], x[state::kVx] + noise(rng),
+                          x[state::kVy] + noise(rng), x[state::kYawRate] + noise(rng), steer, throttle};
+    for (std::size_t c = 0; c < rec.columns.size(); ++c) rec.data[c].push_back(row[c]);
+    const float u[2] = {steer, throttle};
+    for (int j = 0; j < 10; ++j) {
+      const bool on_patch = std::hypot(x[state::kX] - 8.0, x[state::kY]) < 3.0;
+      (on_patch ? slippery : nominal).step<1>(Batch<SingleTrack::kNx, 1>{x}, ConstBatch<2, 1>{u}, 0.002f, nullptr);
+    }
+  }
+  return rec;
+}
+
+}  // namespace
+
+TEST_CASE("a patch of low grip is named as a place, not as a change in time", "[diagnose]") {
+  const DiagData d = prepare(circles_over_a_patch(11, 60.0), "circles over a patch");
+  DiagnoseOptions o;
+  o.plots = false;
+  const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track"), o);
+  std::string named;
+  for (const auto& s : r.selection.selected) named += s + " ";
+  INFO("named: " << named << "; held-out reduction " << r.heldout_rmse_reduction);
+  REQUIRE_FALSE(r.selection.selected.empty());
+  CHECK(r.selection.selected[0] == "grip_patch");
+  CHECK(std::find(r.selection.selected.begin(), r.selection.selected.end(), "friction_change") ==
+        r.selection.selected.end());
+  const EffectParams& e = r.selection.final_effects;
+  CHECK(std::hypot(e.patch_x_m - 8.0, e.patch_y_m) < 1.5);
+  CHECK(e.patch_radius_m == Approx(3.0).margin(1.0));
+  CHECK(e.patch_grip_scale == Approx(0.5).margin(0.15));
+  CHECK(r.heldout_rmse_reduction > 0.3);
+  // Located as a place before the correction; after it, no place stands out on the held-out part.
+  auto at_a_place = [](const std::vector<Mismatch>& ms) {
+    return std::any_of(ms.begin(), ms.end(), [](const Mismatch& m) { return m.where.rfind("place", 0) == 0; });
+  };
+  CHECK(at_a_place(r.mismatch));
+  CHECK_FALSE(at_a_place(r.remaining));
+  CHECK(r.explained_share[2] > 0.3);  // yaw rate: the grip shows in the turns
 }
