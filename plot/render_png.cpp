@@ -252,11 +252,20 @@ void draw_panel(Canvas& cv, const PanelLayout& l, const Panel& panel) {
     if (s.marker != Marker::kNone) draw_markers(cv, l, s);
   }
   if (panel.trail) {
+    // Each segment a filled band (butt ends, 0.5 px longer at each end to close the joins):
+    // stroked lines would get caps, and the next segment's cap would paint over this one.
     const ColourTrail& t = *panel.trail;
-    cv.width(t.width_px);
+    const double ux = (l.x.hi - l.x.lo) / l.axes.width, uy = (l.y.hi - l.y.lo) / l.axes.height;  // data per px
     for (std::size_t i = 0; i + 1 < t.x.size(); ++i) {
+      const double dx = (t.x[i + 1] - t.x[i]) / ux, dy = (t.y[i + 1] - t.y[i]) / uy, len = std::hypot(dx, dy);
+      if (len < 1e-9) continue;
+      const double ex = 0.5 * dx / len, ey = 0.5 * dy / len;                                  // 0.5 px along
+      const double nx = -dy / len * 0.5 * t.width_px, ny = dx / len * 0.5 * t.width_px;       // half width across
+      const double ax = t.x[i] - ex * ux, ay = t.y[i] - ey * uy, bx = t.x[i + 1] + ex * ux, by = t.y[i + 1] + ey * uy;
+      PLFLT px[4] = {ax + nx * ux, bx + nx * ux, bx - nx * ux, ax - nx * ux};
+      PLFLT py[4] = {ay + ny * uy, by + ny * uy, by - ny * uy, ay - ny * uy};
       cv.colour(colour_for_value(t.map, 0.5 * (t.value[i] + t.value[i + 1]), l.colour_axis.lo, l.colour_axis.hi));
-      pljoin(t.x[i], t.y[i], t.x[i + 1], t.y[i + 1]);
+      plfill(4, px, py);
     }
   }
   for (const Series& s : panel.series)

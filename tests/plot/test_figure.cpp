@@ -20,27 +20,29 @@ std::string temp_png(const std::string& name) {
   return (std::filesystem::temp_directory_path() / ("mppi_plot_" + name + "_" + std::to_string(::getpid()) + ".png")).string();
 }
 
-bool dark(const std::array<std::uint8_t, 3>& p) { return p[0] < 100 && p[1] < 100 && p[2] < 100; }
+// The frame is a thin anti-aliased black line (grey where it straddles two pixels); the grid
+// is much lighter (225).
+bool dark(const std::array<std::uint8_t, 3>& p) { return p[0] < 180 && p[1] < 180 && p[2] < 180; }
 bool near(const std::array<std::uint8_t, 3>& p, std::array<int, 3> want, int tol) {
   for (int i = 0; i < 3; ++i)
     if (std::abs(int(p[i]) - want[i]) > tol) return false;
   return true;
 }
 
-// The axes frame: the first dark pixels from each side along a row and a column through the
-// inside of the axes.
+// The axes frame: the first dark pixels met going outwards from points inside the axes (left
+// and right along `row` from `column`; up from up_from and down from down_from along `column`).
 struct Frame {
   int left = -1, right = -1, top = -1, bottom = -1;
 };
-Frame find_frame(const RgbImage& img, int row, int column) {
+Frame find_frame(const RgbImage& img, int row, int column, int up_from, int down_from) {
   Frame f;
-  for (int c = 0; c < img.width && f.left < 0; ++c)
+  for (int c = column; c >= 0 && f.left < 0; --c)
     if (dark(img.at(c, row))) f.left = c;
-  for (int c = img.width - 1; c >= 0 && f.right < 0; --c)
+  for (int c = column; c < img.width && f.right < 0; ++c)
     if (dark(img.at(c, row))) f.right = c;
-  for (int r = 0; r < img.height && f.top < 0; ++r)
+  for (int r = up_from; r >= 0 && f.top < 0; --r)
     if (dark(img.at(column, r))) f.top = r;
-  for (int r = img.height - 1; r >= 0 && f.bottom < 0; --r)
+  for (int r = down_from; r < img.height && f.bottom < 0; ++r)
     if (dark(img.at(column, r))) f.bottom = r;
   return f;
 }
@@ -74,7 +76,7 @@ TEST_CASE("figure PNG: lines land at their data coordinates", "[plot]") {
   REQUIRE(img.width == 640);
   REQUIRE(img.height > 400);
   // A row and a column well inside the axes and off the grid lines and the series.
-  const Frame f = find_frame(img, img.height / 2 - 7, img.width / 2 - 7);
+  const Frame f = find_frame(img, img.height / 2 - 7, img.width / 2 - 7, img.height / 2 - 7, img.height / 2 - 7);
   INFO("frame " << f.left << " " << f.right << " " << f.top << " " << f.bottom);
   REQUIRE(f.left > 20);
   REQUIRE(f.right < img.width - 5);
@@ -119,7 +121,9 @@ TEST_CASE("figure PNG: a colour trail follows the colour map, a long title fits"
   fig.write_png(png);
   const RgbImage img = read_image_rgb(png);
   std::filesystem::remove(png);
-  const Frame f = find_frame(img, static_cast<int>(img.height * 0.62), img.width / 3 - 7);
+  // Start above the trail (y = 5) for the top edge, below it for the bottom edge.
+  const Frame f = find_frame(img, static_cast<int>(img.height * 0.62), img.width / 3 - 7, static_cast<int>(img.height * 0.4),
+                             static_cast<int>(img.height * 0.75));
   INFO("frame " << f.left << " " << f.right << " " << f.top << " " << f.bottom);
   REQUIRE(f.right - f.left > 300);
   const auto at = [&](double x, double y) {
@@ -127,9 +131,10 @@ TEST_CASE("figure PNG: a colour trail follows the colour map, a long title fits"
                   static_cast<int>(std::lround(f.bottom - y / 10 * (f.bottom - f.top))));
   };
   CHECK(near(at(-1, 5), kTurbo0, 3));
+  INFO("at x = 5: " << int(at(5, 5)[0]) << " " << int(at(5, 5)[1]) << " " << int(at(5, 5)[2]));
   CHECK(near(at(5, 5), kTurbo128, 4));
   CHECK(near(at(11, 5), kTurbo255, 3));
-  CHECK(near(at(5, 7), {255, 255, 255}, 0));  // off the trail: background
+  CHECK(near(at(6, 7), {255, 255, 255}, 0));  // off the trail and the grid: background
   // The title is wrapped, not cut at the image edge: the outermost columns stay white.
   for (int r = 0; r < f.top - 30; ++r)
     for (int c : {0, 1, 2, img.width - 3, img.width - 2, img.width - 1}) CHECK(near(img.at(c, r), {255, 255, 255}, 0));
