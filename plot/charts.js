@@ -55,7 +55,7 @@
       else { ctx.moveTo(px(r.at), top); ctx.lineTo(px(r.at), top + ah); }
       ctx.stroke();
     });
-    p.series.forEach(function (s) {
+    function drawSeries(s) {
       ctx.strokeStyle = s.colour; ctx.fillStyle = s.colour;
       if (s.width_px > 0 && s.x.length > 1) {
         ctx.lineWidth = s.width_px; dash(ctx, s.dash, s.width_px);
@@ -76,7 +76,9 @@
         points.push({X: X, Y: Y, text: (s.label || "series") + "\n" + (p.x_label || "x") + " = " + valueFormat(s.x[k]) +
                      "\n" + (p.y_label || "y") + " = " + valueFormat(s.y[k])});
       }
-    });
+    }
+    // Lines, then the colour trail, then scatter-only series on top (as in the PNG).
+    p.series.forEach(function (s) { if (s.width_px > 0) drawSeries(s); });
     var t = p.trail;
     if (t) {
       var ca = t.colour_axis;
@@ -93,6 +95,7 @@
         points.push({X: px(t.x[q]), Y: py(t.y[q]), text: (p.x_label || "x") + " = " + valueFormat(t.x[q]) + "\n" +
                      (p.y_label || "y") + " = " + valueFormat(t.y[q]) + "\n" + (t.value_label || "value") + " = " + valueFormat(t.value[q])});
     }
+    p.series.forEach(function (s) { if (!(s.width_px > 0)) drawSeries(s); });
     ctx.restore();
     // Frame, ticks, labels.
     ctx.strokeStyle = "#141414"; ctx.lineWidth = 1; ctx.setLineDash([]);

@@ -49,7 +49,8 @@ std::vector<std::string> split_words(const std::string& text) {
 }
 
 std::string trim(std::string s) {
-  while (!s.empty() && s.back() == ' ') s.pop_back();
+  // Also a " |" left at the end of a line by a break after a part.
+  while (!s.empty() && (s.back() == ' ' || (s.back() == '|' && s.size() > 1 && s[s.size() - 2] == ' '))) s.pop_back();
   while (!s.empty() && s.front() == ' ') s.erase(s.begin());
   return s;
 }
@@ -95,14 +96,33 @@ TextBlock fit_text(const std::string& text, double width_px, double size_px, int
     block.line_px = std::round(1.3 * size);
     bool words_fit = true;
     for (const std::string& para : paragraphs) {
+      // Parts separated by " | " stay whole where they fit on a line; longer ones break at spaces.
+      std::vector<std::string> parts;
+      for (std::size_t from = 0;;) {
+        const std::size_t bar = para.find(" | ", from);
+        parts.push_back(para.substr(from, bar == std::string::npos ? std::string::npos : bar + 3 - from));
+        if (bar == std::string::npos) break;
+        from = bar + 3;
+      }
       std::string cur;
-      for (const std::string& w : split_words(para)) {
-        if (!cur.empty() && text_width_px(trim(cur + w), size) > width_px) {
-          block.lines.push_back(trim(cur));
-          cur.clear();
+      for (const std::string& part : parts) {
+        if (text_width_px(trim(cur + part), size) <= width_px) {
+          cur += part;
+          continue;
         }
-        if (text_width_px(trim(w), size) > width_px) words_fit = false;
-        cur += w;
+        if (!cur.empty() && text_width_px(trim(part), size) <= width_px) {
+          block.lines.push_back(trim(cur));
+          cur = part;
+          continue;
+        }
+        for (const std::string& w : split_words(part)) {
+          if (!cur.empty() && text_width_px(trim(cur + w), size) > width_px) {
+            block.lines.push_back(trim(cur));
+            cur.clear();
+          }
+          if (text_width_px(trim(w), size) > width_px) words_fit = false;
+          cur += w;
+        }
       }
       block.lines.push_back(trim(cur));
     }
