@@ -88,7 +88,7 @@ plot::Figure overlay_figure(const DiagData& d, const ReplayModel& nominal, const
     fig.add(p);
     return fig;
   }
-  const std::size_t thin = std::max<std::size_t>(1, rows.size() / 3000);  // keep a few thousand points per series
+  const std::size_t thin = std::max<std::size_t>(1, rows.size() / 1000);  // keep about a thousand points per series
   // x-y: the measured path (broken where rows are not consecutive) and 2-s predictions every 1 s.
   plot::Panel pxy;
   pxy.title = "x-y, 2 s open-loop predictions every 1 s";
@@ -114,7 +114,7 @@ plot::Figure overlay_figure(const DiagData& d, const ReplayModel& nominal, const
   }
   const int len2 = std::max(1, static_cast<int>(std::lround(2.0 / d.dt_s)));
   const int every = std::max(1, static_cast<int>(std::lround(1.0 / d.dt_s)));
-  const int pred_thin = std::max(1, len2 / 40);
+  const int pred_thin = std::max(1, len2 / 20);
   const auto segs = make_segments(d, mask, len2, every);
   std::vector<double> pred(static_cast<std::size_t>(len2) * kPredStride);
   for (const auto& s : segs)

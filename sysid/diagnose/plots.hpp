@@ -19,7 +19,7 @@ plot::Figure residual_vs_regime_figure(const DiagData& d, const ResidualSeries& 
 
 // Top: x-y of the held-out part with 2-s open-loop predictions every 1 s (nominal red,
 // corrected blue, measured black); below: vx and yaw rate against time with the 1-s-ahead
-// predictions. Long series are thinned to a few thousand points.
+// predictions. Long series are thinned to about a thousand points.
 plot::Figure overlay_figure(const DiagData& d, const ReplayModel& nominal, const ReplayModel& corrected,
                             const std::vector<char>& mask, const ReplayOptions& o);
 
