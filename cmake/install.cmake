@@ -2,14 +2,14 @@
 # package so that an out-of-tree project can do find_package(mppi) and link mppi::core etc.
 include(CMakePackageConfigHelpers)
 
-foreach(folder IN ITEMS mppi dynamics costs sim chassis)
+foreach(folder IN ITEMS mppi dynamics costs sim chassis plot)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${folder}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/${folder}
           FILES_MATCHING PATTERN "*.hpp")
 endforeach()
 install(FILES ${MPPI_GENERATED_DIR}/mppi/model_list.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/mppi)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/data/ DESTINATION ${CMAKE_INSTALL_DATADIR}/mppi/data)
 
-install(TARGETS mppi_core mppi_io mppi_sim mppi_chassis mppi_warnings EXPORT mppiTargets
+install(TARGETS mppi_core mppi_io mppi_plot mppi_sim mppi_chassis mppi_warnings EXPORT mppiTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})

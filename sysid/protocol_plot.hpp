@@ -1,6 +1,7 @@
 #pragma once
-// PNG of a simulated protocol run (sysid/protocol.hpp): the driven path coloured by manoeuvre
-// (left) and the true vx, vy and yaw rate over time with the manoeuvre boundaries (right).
+// PNG of a simulated protocol run (sysid/protocol.hpp), drawn by mppi::plot: the driven path
+// coloured by manoeuvre, and the true vx, vy and yaw rate over time in the same colours with the
+// manoeuvre boundaries.
 #include <string>
 
 #include "sysid/protocol.hpp"

@@ -6,7 +6,12 @@
 #include <fstream>
 #include <sstream>
 
+#include <optional>
+
 #include <nlohmann/json.hpp>
+
+#include "plot/figure_json.hpp"
+#include "plot/html_report.hpp"
 
 #include "mppi/error.hpp"
 #include "sysid/diagnose/plots.hpp"
@@ -193,6 +198,14 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
   j["metrics_after"] = metrics_json(res.after);
   j["selection_log"] = res.selection.log;
   j["model_file"] = res.model_file;
+  // The report's figures: the same data in report.json, the PNGs and report.html.
+  std::optional<plot::Figure> regime_fig, overlay_fig;
+  if (!o.out_dir.empty() && o.plots) {
+    regime_fig = residual_vs_regime_figure(d, rs, rs_after, held);
+    overlay_fig = overlay_figure(d, nominal_model, corrected, held, o.replay);
+    j["figures"] = {{"residual_vs_regime", plot::figure_to_json(*regime_fig)},
+                    {"overlay", plot::figure_to_json(*overlay_fig)}};
+  }
   res.json = j.dump(2);
 
   if (!o.out_dir.empty()) {
@@ -287,8 +300,11 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
     md << "```\n";
     std::ofstream(o.out_dir + "/report.md") << md.str();
     if (o.plots) {
-      plot_residual_vs_regime(o.out_dir + "/residual_vs_regime.png", d, rs, rs_after, held);
-      plot_overlay(o.out_dir + "/overlay.png", d, nominal_model, corrected, held, o.replay);
+      regime_fig->write_png(o.out_dir + "/residual_vs_regime.png");
+      overlay_fig->write_png(o.out_dir + "/overlay.png");
+      plot::write_html_report(o.out_dir + "/report.html", "Sim-vs-real diagnosis", md.str(),
+                              {{"residual_vs_regime.png", j["figures"]["residual_vs_regime"]},
+                               {"overlay.png", j["figures"]["overlay"]}});
     }
   }
   return res;

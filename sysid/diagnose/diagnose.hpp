@@ -1,7 +1,7 @@
 #pragma once
 // `mppi-fit diagnose` as a library call: locate the mismatch between a recording and a nominal
 // model, name the missing physics, write the corrected model, show the held-out fit before and
-// after (report.json, report.md, residual_vs_regime.png, overlay.png, corrected_model.yaml).
+// after (report.json, report.md, report.html, residual_vs_regime.png, overlay.png, corrected_model.yaml).
 #include <string>
 #include <vector>
 

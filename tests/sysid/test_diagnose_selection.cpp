@@ -87,6 +87,31 @@ TEST_CASE("two hidden effects at once are both named; report and model file agre
   CHECK(f.effects.throttle_lag_s == Approx(0.25).margin(0.04));
   CHECK(std::filesystem::file_size(dir / "overlay.png") > 1000);
   CHECK(std::filesystem::file_size(dir / "residual_vs_regime.png") > 1000);
+  // report.html: self-contained, its embedded figures are report.json's, in the report's order.
+  std::ifstream html_in(dir / "report.html");
+  const std::string html((std::istreambuf_iterator<char>(html_in)), std::istreambuf_iterator<char>());
+  CHECK(html.rfind("<!DOCTYPE html>", 0) == 0);
+  CHECK(html.find("http://") == std::string::npos);
+  CHECK(html.find("https://") == std::string::npos);
+  CHECK(html.find("<img") == std::string::npos);  // both images became interactive figures
+  CHECK(html.find("<table>") != std::string::npos);  // the Markdown tables are rendered
+  const std::string open_tag = "<script type=\"application/json\" id=\"mppi-figures\">";
+  const std::size_t a = html.find(open_tag);
+  REQUIRE(a != std::string::npos);
+  const std::size_t b = html.find("</script>", a);
+  REQUIRE(b != std::string::npos);
+  const auto embedded = nlohmann::json::parse(html.substr(a + open_tag.size(), b - a - open_tag.size()));
+  REQUIRE(j.contains("figures"));
+  REQUIRE(embedded.size() == 2);
+  CHECK(embedded[0] == j["figures"]["residual_vs_regime"]);
+  CHECK(embedded[1] == j["figures"]["overlay"]);
+  CHECK(html.find("data-figure=\"0\"") < html.find("data-figure=\"1\""));
+  // The overlay's vx panel holds the measured series.
+  const auto& vx_panel = j["figures"]["overlay"]["panels"][1];
+  CHECK(vx_panel["y_label"] == "vx [m/s]");
+  REQUIRE(!vx_panel["series"].empty());
+  CHECK(vx_panel["series"][0]["label"] == "measured");
+  CHECK(vx_panel["series"][0]["x"].size() > 100);
   std::filesystem::remove_all(dir);
 }
 
