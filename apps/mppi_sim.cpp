@@ -8,6 +8,9 @@
 #include "dynamics/model_registry.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/summary.hpp"
+#ifdef MPPI_HAVE_OCS
+#include "ocs/serve.hpp"
+#endif
 
 namespace {
 
@@ -38,6 +41,9 @@ const char* kUsage = R"(usage: mppi-sim [options]
   --out DIR            write DIR/log.csv, DIR/track.png, DIR/summary.json (default out/sim)
   --json               print summary.json to stdout
   --quiet              no progress lines
+  --serve PORT         operator page on http://127.0.0.1:PORT/ while driving, in real time (docs/OCS.md)
+  --fast               with --serve: do not hold the simulation to wall-clock time
+  --replay FILE        serve FILE (a recording) on the operator page for replay (with --serve PORT)
 )";
 
 [[noreturn]] void usage_error(const std::string& msg) {
@@ -69,6 +75,9 @@ int main(int argc, char** argv) {
   config.out_dir = "out/sim";
   config.backend = mppi::BackendChoice::kAuto;
   bool print_json = false;
+  int serve_port = -1;
+  bool serve_fast = false;
+  std::string replay_csv;
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
     auto value = [&]() -> std::string {
@@ -110,15 +119,34 @@ int main(int argc, char** argv) {
     else if (flag == "--out") config.out_dir = value();
     else if (flag == "--json") print_json = true;
     else if (flag == "--quiet") config.progress = false;
+    else if (flag == "--serve") serve_port = parse_int(flag, value());
+    else if (flag == "--fast") serve_fast = true;
+    else if (flag == "--replay") replay_csv = value();
     else usage_error("unknown option " + flag);
   }
   try {
+#ifdef MPPI_HAVE_OCS
+    mppi::ocs::ServeOptions serve;
+    serve.port = serve_port;
+    serve.realtime = !serve_fast;
+    if (!replay_csv.empty()) {
+      if (serve_port < 0) usage_error("--replay needs --serve PORT");
+      return mppi::ocs::serve_recording(replay_csv, "", serve);
+    }
+#else
+    if (serve_port >= 0 || !replay_csv.empty()) usage_error("this build has no operator page (ocs/CMakeLists.txt says why)");
+#endif
     if (config.progress)
       std::fprintf(stderr, "mppi-sim: %s track, model %s, plant %s, %.1f m/s, K = %d, T = %d, seed %llu\n",
                    config.track.c_str(), config.model.c_str(), config.plant.c_str(),
                    config.target_speed_mps, config.controller.num_samples, config.controller.horizon,
                    static_cast<unsigned long long>(config.controller.seed));
+#ifdef MPPI_HAVE_OCS
+    const mppi::sim::RunSummary summary =
+        serve_port >= 0 ? mppi::ocs::run_closed_loop_with_page(config, serve) : mppi::sim::run_closed_loop(config);
+#else
     const mppi::sim::RunSummary summary = mppi::sim::run_closed_loop(config);
+#endif
     if (config.progress)
       std::fprintf(stderr, "done: %d/%d laps, %d crashes, mean %.2f m/s, max %.2f m/s, optimizer p50 %.2f ms p99 %.2f ms -> %s\n",
                    summary.laps_completed, config.laps, summary.crashes, summary.mean_speed_mps,
