@@ -150,6 +150,10 @@ void OcsServer::add_routes() {
     live_->add_client();
     res.set_header("Cache-Control", "no-cache");
     auto seen = std::make_shared<std::uint64_t>(0);
+    {  // a new page starts with the next frame, not one made for an earlier page
+      const std::lock_guard<std::mutex> lock(latest_mutex_);
+      *seen = latest_sequence_;
+    }
     res.set_chunked_content_provider(
         "text/event-stream",
         [this, seen](std::size_t, httplib::DataSink& sink) {

@@ -238,7 +238,10 @@ function startLive(info) {
     redrawCharts();
     drawScene(f);
     showStatus(f);
-    if (testMode && frames === 15) report({ mode: 'live', frames, t: f.t, rollouts_in_frame: f.rollouts.length });
+    if (testMode && frames === 15) {  // the browser test: report, then hold the picture still
+      source.close();
+      report({ mode: 'live', frames, t: f.t, rollouts_in_frame: f.rollouts.length });
+    }
   };
   source.onerror = () => { $('mode').textContent = 'live simulation (disconnected)'; };
   const post = async (params) => {
@@ -329,10 +332,10 @@ function report(extra) {
   }
   const result = { ...extra, car_pixels: car, rollout_pixels: rollout, plan_pixels: plan, trail_pixels: trailPx,
                    charts: Object.keys(charts).length, uplot: typeof uPlot === 'function' };
-  const el = $('test-report');
-  el.textContent = JSON.stringify(result);
-  el.hidden = false;
   document.title = 'OCS-TEST ' + JSON.stringify(result);
+  const el = $('test-report');  // with the map's pixels, for a check independent of these counts
+  el.textContent = JSON.stringify({ ...result, canvas_png: canvas.toDataURL('image/png') });
+  el.hidden = false;
 }
 
 // ---- start ----
