@@ -221,8 +221,16 @@ let frames = 0, lastFrame = null;
 function startLive(info) {
   $('mode').textContent = 'live simulation';
   $('st-priorities').textContent = info.priorities.map((p) => `${p.sender} (${p.priority})`).join(', ') || '–';
-  const source = new EventSource('/api/stream');
-  source.onmessage = (event) => {
+  let source = new EventSource('/api/stream');
+  const cycle = +new URLSearchParams(location.search).get('cycle');
+  if (cycle > 0)  // the timing measurement: connected for `cycle` seconds, then not, and so on
+    setInterval(() => {
+      if (source.readyState === EventSource.CLOSED) {
+        source = new EventSource('/api/stream');
+        source.onmessage = onFrame;
+      } else source.close();
+    }, cycle * 1000);
+  const onFrame = (event) => {
     const f = JSON.parse(event.data);
     ++frames;
     lastFrame = f;
@@ -243,6 +251,7 @@ function startLive(info) {
       report({ mode: 'live', frames, t: f.t, rollouts_in_frame: f.rollouts.length });
     }
   };
+  source.onmessage = onFrame;
   source.onerror = () => { $('mode').textContent = 'live simulation (disconnected)'; };
   const post = async (params) => {
     const r = await fetch('/api/control', { method: 'POST', body: new URLSearchParams(params) });
