@@ -17,6 +17,7 @@ std::string commander_name(int commander, const std::vector<chassis::PriorityEnt
   if (commander >= 0 && commander < static_cast<int>(priorities.size())) return priorities[commander].sender;
   if (commander == chassis::kRunstop) return "runstop";
   if (commander == chassis::kWatchdog) return "watchdog";
+  if (commander == kCommanderNotReported) return "not reported";
   return "none";
 }
 

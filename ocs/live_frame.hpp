@@ -19,6 +19,9 @@ namespace mppi::ocs {
 // Paths drawn per frame: the plan and kChunk - 1 sampled rollouts (one batch of the model).
 inline constexpr int kPathsPerFrame = kChunk;
 
+// A commander the chassis does not report (a remote chassis' state message carries none).
+inline constexpr int kCommanderNotReported = -100;
+
 struct ChassisStatus {
   bool present = false;          // false: the loop has no chassis between controller and car
   bool motion_enabled = false;   // runstop state: true = autonomous motion allowed

@@ -51,8 +51,12 @@ void LiveObserver::after_step(const sim::StepView& view) {
   f.crashes = view.crashes;
   f.progress_m = view.progress_m;
   f.target_speed_mps = view.target_speed_mps;
-  f.chassis.present = view.chassis != nullptr;
-  if (view.chassis) {
+  f.chassis.present = view.chassis != nullptr || view.remote_chassis;
+  if (view.remote_chassis) {  // only the flags of its state message; who commands is not sent
+    f.chassis.motion_enabled = view.remote_motion_enabled;
+    f.chassis.watchdog_tripped = view.remote_watchdog_tripped;
+    f.chassis.steering_commander = f.chassis.throttle_commander = f.chassis.front_brake_commander = kCommanderNotReported;
+  } else if (view.chassis) {
     const chassis::Decision& d = view.chassis->last_output().decision;
     f.chassis.motion_enabled = d.motion_enabled;
     f.chassis.watchdog_tripped = d.watchdog_tripped;

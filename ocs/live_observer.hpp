@@ -23,6 +23,7 @@ namespace mppi::ocs {
 struct LiveSettings {
   double frame_rate_hz = 20.0;  // frames captured per second of wall time, at most
   bool realtime = true;         // hold the simulation to wall-clock time
+  bool allow_pause = true;      // false: the page's pause is refused (a vehicle cannot pause)
 };
 
 // Optimizer times split by whether a page was connected during the step.
@@ -49,7 +50,8 @@ class LiveObserver final : public sim::StepObserver {
   void add_client() { clients_.fetch_add(1); }
   void remove_client() { clients_.fetch_sub(1); }
   int clients() const { return clients_.load(); }
-  void request_pause(bool paused) { paused_ = paused; }
+  bool pause_allowed() const { return settings_.allow_pause; }
+  void request_pause(bool paused) { paused_ = paused && settings_.allow_pause; }
   void request_target_speed(double mps);
   void request_motion_enabled(bool enabled);
   void request_stop() { stop_ = true; }

@@ -119,6 +119,7 @@ void OcsServer::add_routes() {
                                  {"has_track", !track_json_.empty()},
                                  {"priorities", std::move(priorities)},
                                  {"paused", live_ && live_->paused()},
+                                 {"can_pause", live_ && live_->pause_allowed()},
                                  {"finished", live_ && live_->finished()},
                                  {"clients", live_ ? live_->clients() : 0}};
     res.set_content(info.dump(), "application/json");
@@ -197,6 +198,8 @@ void OcsServer::add_routes() {
         return reply_error(res, 400, "unknown parameter '" + name + "' (expected pause, target_speed, runstop or stop)");
       }
     }
+    if (pause && !live_->pause_allowed())
+      return reply_error(res, 400, "pause: a vehicle cannot be paused (use runstop)");
     if (pause) live_->request_pause(*pause);
     if (target) live_->request_target_speed(*target);
     if (runstop) live_->request_motion_enabled(!*runstop);

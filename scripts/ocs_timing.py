@@ -26,6 +26,9 @@ def main():
     ap.add_argument("--seconds", type=float, default=120)
     ap.add_argument("--cycle", type=float, default=5)
     ap.add_argument("--out", default="out/ocs_timing")
+    ap.add_argument("--client", choices=["chromium", "stream"], default="chromium",
+                    help="chromium: the page in a headless browser on this machine; stream: a reader of the "
+                         "frame stream that draws nothing (the server's own cost)")
     ap.add_argument("sim_args", nargs="*")
     a = ap.parse_args()
     chromium = shutil.which("chromium")
@@ -43,18 +46,40 @@ def main():
             break
         except OSError:
             time.sleep(0.2)
+    if a.client == "stream":
+        stream_cycles(port, a.seconds, a.cycle)
+    else:
+        browse(chromium, url, a.seconds, a.cycle)
+    urllib.request.urlopen(urllib.request.Request(url + "/api/control", data=b"stop=1"), timeout=10)
+    sim.wait(timeout=120)
+    print(json.dumps(json.load(open(os.path.join(a.out, "ocs_timing.json"))), indent=2))
+
+
+def stream_cycles(port, seconds, cycle):
+    """Reads /api/stream for `cycle` seconds, then stays away for `cycle` seconds, and so on."""
+    end = time.time() + seconds
+    while time.time() < end:
+        with socket.create_connection(("127.0.0.1", port), timeout=5) as s:
+            s.sendall(b"GET /api/stream HTTP/1.1\r\nHost: x\r\n\r\n")
+            until = time.time() + cycle
+            while time.time() < until:
+                try:
+                    s.recv(1 << 20)
+                except socket.timeout:
+                    pass
+        time.sleep(cycle)
+
+
+def browse(chromium, url, seconds, cycle):
     env = dict(os.environ, DBUS_SESSION_BUS_ADDRESS="disabled:")
     # a browser that stays on the page until we end it (a DevTools port keeps headless Chromium open)
     browser = subprocess.Popen([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
                                 "--window-size=1400,1150", "--remote-debugging-port=0",
-                                f"{url}/?cycle={a.cycle}"], env=env, stdout=subprocess.DEVNULL,
+                                f"{url}/?cycle={cycle}"], env=env, stdout=subprocess.DEVNULL,
                                stderr=subprocess.DEVNULL)
-    time.sleep(a.seconds)
+    time.sleep(seconds)
     browser.terminate()
     browser.wait(timeout=60)
-    urllib.request.urlopen(urllib.request.Request(url + "/api/control", data=b"stop=1"), timeout=10)
-    sim.wait(timeout=120)
-    print(json.dumps(json.load(open(os.path.join(a.out, "ocs_timing.json"))), indent=2))
 
 
 if __name__ == "__main__":

@@ -9,6 +9,7 @@ MPPI_DEBIAN_PACKAGES=(
   nlohmann-json3-dev catch2 libbenchmark-dev
   python3 python3-numpy python3-dev python3-pytest pybind11-dev
   mesa-vulkan-drivers libvulkan-dev glslang-tools spirv-tools
+  libcpp-httplib-dev nodejs npm chromium
 )
 
 mppi_missing_packages() {

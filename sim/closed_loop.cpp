@@ -259,9 +259,11 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
       log->write(t, s, command, extras);
     }
     if (config.observer)
-      config.observer->after_step({t, s, model_x, output, plant.applied(), &step_summary, controller,
-                                   chassis ? &*chassis : nullptr, laps.laps_completed(), summary.crashes,
-                                   laps.progress_m(), target_speed_mps});
+      config.observer->after_step({.t_s = t, .state = s, .model_state = model_x, .output = output,
+                                   .applied = plant.applied(), .summary = &step_summary, .controller = controller,
+                                   .chassis = chassis ? &*chassis : nullptr, .laps_completed = laps.laps_completed(),
+                                   .crashes = summary.crashes, .progress_m = laps.progress_m(),
+                                   .target_speed_mps = target_speed_mps});
     if (!std::isfinite(s.x_m) || !std::isfinite(s.vx_mps))
       throw Error("the plant state became non-finite at t = " + std::to_string(t) + " s");
     if (laps.laps_completed() > reported_laps && config.progress) {

@@ -39,6 +39,10 @@ struct StepView {
   int crashes = 0;
   double progress_m = 0.0;
   double target_speed_mps = 0.0;
+  // A chassis known only by its state messages (over UDP): its runstop and watchdog flags.
+  bool remote_chassis = false;
+  bool remote_motion_enabled = false;
+  bool remote_watchdog_tripped = true;
 };
 
 struct OperatorRequests {

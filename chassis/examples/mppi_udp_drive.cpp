@@ -27,6 +27,10 @@
 #include "sim/data_dir.hpp"
 #include "sim/lap_counter.hpp"
 #include "sim/track.hpp"
+#ifdef MPPI_HAVE_OCS
+#include "ocs/loop_page.hpp"
+#include "sim/path_predictor.hpp"
+#endif
 
 namespace {
 
@@ -45,6 +49,7 @@ constexpr const char* kUsage = R"(usage: mppi-udp-drive [options]
   --seed N             noise seed                               (1)
   --duration S         stop after S seconds; 0 = until Ctrl-C   (30)
   --param-port N       UDP port for parameter messages, 0 = off (47801)
+  --serve PORT         operator page on http://127.0.0.1:PORT/ (docs/OCS.md)
 )";
 
 std::atomic<bool> g_stop{false};
@@ -68,7 +73,7 @@ int main(int argc, char** argv) {
   using namespace mppi::chassis;
   std::string host = "127.0.0.1", name = "mppi", runstop_name = "OCS", model = models::AutoRallyNetworkModel::kName,
               track_name = "gazebo";
-  int port = udp::kDefaultPort, param_port = udp::kDefaultParameterPort;
+  int port = udp::kDefaultPort, param_port = udp::kDefaultParameterPort, serve_port = -1;
   double speed = 6.0, duration_s = 30.0;
   ControlLoopSettings loop_settings;
   ControllerOptions options;
@@ -95,6 +100,7 @@ int main(int argc, char** argv) {
     else if (flag == "--seed") options.seed = static_cast<std::uint64_t>(number(flag, value()));
     else if (flag == "--duration") duration_s = number(flag, value());
     else if (flag == "--param-port") param_port = static_cast<int>(number(flag, value()));
+    else if (flag == "--serve") serve_port = static_cast<int>(number(flag, value()));
     else usage_error("unknown option " + flag);
   }
   try {
@@ -106,6 +112,12 @@ int main(int argc, char** argv) {
     // Any registered model with its default data; it reads the chassis' common states.
     std::unique_ptr<Controller> controller;
     std::function<void(const float* common, float* model_x)> observe;
+#ifdef MPPI_HAVE_OCS
+    std::unique_ptr<ocs::LoopPage> page;  // --serve
+    StepSummary summary;
+#else
+    if (serve_port >= 0) usage_error("this build has no operator page (ocs/CMakeLists.txt says why)");
+#endif
     if (!is_registered_model(model)) usage_error("unknown model '" + model + "' (valid: " + model_names() + ")");
     with_model(model, [&]<class D>() {
       const std::string default_file = D::kDefaultFile;
@@ -113,6 +125,10 @@ int main(int argc, char** argv) {
       controller = std::make_unique<Controller>(make_cpu_controller(m, cost, options));
       loop_settings.state_size = D::Model::kNx;
       observe = [m](const float* common, float* model_x) { D::from_plant(m, common, state::kCommonStates, model_x); };
+#ifdef MPPI_HAVE_OCS
+      if (serve_port >= 0)
+        page = std::make_unique<ocs::LoopPage>(serve_port, track_name, sim::make_path_predictor(m, options.dt_s), speed);
+#endif
     });
 
     udp::UdpChassisClient commands(name, host, port);
@@ -154,7 +170,11 @@ int main(int argc, char** argv) {
     ControlLoop loop(
         loop_settings, clock,
         [&](std::span<float> x) {
+#ifdef MPPI_HAVE_OCS
+          runstop.send_runstop(!page || page->motion_allowed());  // the operator's heartbeat, every tick
+#else
           runstop.send_runstop(true);  // the operator's heartbeat, every tick
+#endif
           if (latest.try_take(&state_msg, &seen)) have_state = true, state_at = clock.now();
           // No state, or none for 0.1 s (the chassis is gone): publish nothing this tick.
           if (!have_state || clock.now() - state_at > seconds(0.1)) return false;
@@ -177,6 +197,16 @@ int main(int argc, char** argv) {
             }
             applying.clear();
           }
+#ifdef MPPI_HAVE_OCS
+          if (page) {
+            page->apply_requests(*controller);
+            const auto u = controller->step(x, &summary);
+            page->after_step(state_msg.time_s, VehicleState::from_array(state_msg.state.data()), x,
+                             {u[control::kSteer], u[control::kThrottle]}, {state_msg.applied[0], state_msg.applied[1]},
+                             summary, *controller, state_msg.motion_enabled, state_msg.watchdog_tripped);
+            return Command{u[control::kSteer], u[control::kThrottle], 0.f, actuator::kAll};
+          }
+#endif
           const auto u = controller->step(x);
           return Command{u[control::kSteer], u[control::kThrottle], 0.f, actuator::kAll};
         },

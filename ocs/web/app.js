@@ -6,6 +6,8 @@
 const CHART_SECONDS = 30;
 const TRAIL_POINTS = 4000;
 const testMode = new URLSearchParams(location.search).has('test');
+// ?frames=N: stop streaming after N frames (the browser test: 15)
+const holdAfter = +(new URLSearchParams(location.search).get('frames') || (testMode ? 15 : 0));
 const $ = (id) => document.getElementById(id);
 
 // ---- colours (distinct families, so a test can find each in the pixels) ----
@@ -87,19 +89,41 @@ function drawBackground(track) {
 const trail = [];  // {x, y, speed}
 let maxSpeed = 8;
 
-function drawScene(frame) {
-  ctx.drawImage(background, 0, 0);
-  // trail coloured by speed
-  ctx.lineWidth = 2.5;
-  for (let i = 1; i < trail.length; ++i) {
+// The trail is drawn once per segment onto its own layer (a live page adds one segment a frame).
+const trailLayer = document.createElement('canvas');
+trailLayer.width = canvas.width;
+trailLayer.height = canvas.height;
+const trailCtx = trailLayer.getContext('2d');
+let trailDrawn = 0;  // segments of `trail` already on the layer
+
+function drawTrail() {
+  if (trailDrawn > trail.length) {  // the trail was cut (replay moved back): start again
+    trailCtx.clearRect(0, 0, trailLayer.width, trailLayer.height);
+    trailDrawn = 0;
+  }
+  trailCtx.lineWidth = 2.5;
+  for (let i = Math.max(1, trailDrawn); i < trail.length; ++i) {
     const a = trail[i - 1], b = trail[i];
     if (Math.hypot(b.x - a.x, b.y - a.y) > 3) continue;  // a respawn: no line across the map
-    ctx.strokeStyle = rgb(lerp(TRAIL_SLOW, TRAIL_FAST, Math.min(1, b.speed / maxSpeed)));
-    ctx.beginPath();
-    ctx.moveTo(...px(a.x, a.y));
-    ctx.lineTo(...px(b.x, b.y));
-    ctx.stroke();
+    trailCtx.strokeStyle = rgb(lerp(TRAIL_SLOW, TRAIL_FAST, Math.min(1, b.speed / maxSpeed)));
+    trailCtx.beginPath();
+    trailCtx.moveTo(...px(a.x, a.y));
+    trailCtx.lineTo(...px(b.x, b.y));
+    trailCtx.stroke();
   }
+  trailDrawn = trail.length;
+}
+
+function clearTrail() {
+  trail.length = 0;
+  trailDrawn = 0;
+  trailCtx.clearRect(0, 0, trailLayer.width, trailLayer.height);
+}
+
+function drawScene(frame) {
+  ctx.drawImage(background, 0, 0);
+  drawTrail();
+  ctx.drawImage(trailLayer, 0, 0);
   if (!frame) return;
   // rollouts coloured by weight (log scale over three decades), the heaviest drawn last
   const rollouts = frame.rollouts || [], weights = frame.weights || [];
@@ -216,10 +240,11 @@ function showStatus(f) {
 }
 
 // ---- live mode ----
-let frames = 0, lastFrame = null;
+let frames = 0, lastFrame = null, chartsDrawnAt = 0;
 
 function startLive(info) {
-  $('mode').textContent = 'live simulation';
+  $('mode').textContent = info.can_pause ? 'live simulation' : 'live vehicle';
+  $('pause').hidden = !info.can_pause;
   $('st-priorities').textContent = info.priorities.map((p) => `${p.sender} (${p.priority})`).join(', ') || '–';
   let source = new EventSource('/api/stream');
   const cycle = +new URLSearchParams(location.search).get('cycle');
@@ -234,8 +259,8 @@ function startLive(info) {
     const f = JSON.parse(event.data);
     ++frames;
     lastFrame = f;
+    if (trail.length >= TRAIL_POINTS) clearTrail();
     trail.push({ x: f.x, y: f.y, speed: f.speed });
-    if (trail.length > TRAIL_POINTS) trail.shift();
     maxSpeed = Math.max(maxSpeed, f.speed, f.target_speed * 1.2);
     pushChart('speed', f.t, [f.speed, f.target_speed]);
     pushChart('slip', f.t, [f.slip * 180 / Math.PI]);
@@ -243,12 +268,15 @@ function startLive(info) {
     pushChart('throttle', f.t, [f.throttle, f.applied_throttle]);
     pushChart('opt', f.t, [f.optimizer_ms]);
     pushChart('ess', f.t, [f.ess]);
-    redrawCharts();
+    if (performance.now() - chartsDrawnAt > 200 || frames === holdAfter) {  // charts at 5 Hz
+      chartsDrawnAt = performance.now();
+      redrawCharts();
+    }
     drawScene(f);
     showStatus(f);
-    if (testMode && frames === 15) {  // the browser test: report, then hold the picture still
+    if (frames === holdAfter) {  // a screenshot or the browser test: hold the picture still
       source.close();
-      report({ mode: 'live', frames, t: f.t, rollouts_in_frame: f.rollouts.length });
+      if (testMode) report({ mode: 'live', frames, t: f.t, rollouts_in_frame: f.rollouts.length });
     }
   };
   source.onmessage = onFrame;
@@ -286,8 +314,8 @@ function startReplay(rec) {
   const slider = $('slider');
   slider.max = n - 1;
   const show = (i) => {
-    trail.length = 0;
-    for (let k = 0; k <= i; ++k) trail.push({ x: col.x[k], y: col.y[k], speed: speed[k] });
+    if (i + 1 < trail.length) clearTrail();
+    for (let k = trail.length; k <= i; ++k) trail.push({ x: col.x[k], y: col.y[k], speed: speed[k] });
     cursorTime = col.t[i];
     redrawCharts();
     const f = { x: col.x[i], y: col.y[i], yaw: col.yaw[i] };
