@@ -1,6 +1,8 @@
 #include "ocs/server.hpp"
 
 #include <httplib.h>
+#include <pthread.h>
+#include <sched.h>
 
 #include <chrono>
 #include <cmath>
@@ -28,6 +30,19 @@ bool parse_flag(const std::string& name, const std::string& text, bool* value, s
   return false;
 }
 
+// The page comes after the controller: every thread of the server runs under SCHED_IDLE, so it
+// only gets a core the controller's threads leave idle (Linux; elsewhere nothing changes).
+void yield_to_controller() {
+#ifdef SCHED_IDLE
+  thread_local bool lowered = false;
+  if (lowered) return;
+  sched_param param{};
+  param.sched_priority = 0;
+  pthread_setschedparam(pthread_self(), SCHED_IDLE, &param);
+  lowered = true;
+#endif
+}
+
 }  // namespace
 
 OcsServer::OcsServer(ServerSettings settings, LiveObserver* live, std::string track_json, std::string recording_json)
@@ -49,7 +64,10 @@ void OcsServer::start() {
   if (port_ <= 0)
     throw Error("ocs server: cannot listen on " + settings_.bind_address + ":" + std::to_string(settings_.port) +
                 " (in use, or not an address of this machine)");
-  listener_ = std::thread([this] { http_->listen_after_bind(); });
+  listener_ = std::thread([this] {
+    yield_to_controller();
+    http_->listen_after_bind();
+  });
   if (live_) publisher_ = std::thread([this] { publish_loop(); });
 }
 
@@ -70,6 +88,7 @@ void OcsServer::stop() {
 void OcsServer::publish_loop() {
   const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
       std::chrono::duration<double>(1.0 / settings_.frame_rate_hz));
+  yield_to_controller();
   LiveFrame frame;
   std::uint64_t seen = 0;
   auto next = std::chrono::steady_clock::now();
@@ -93,6 +112,10 @@ void OcsServer::publish_loop() {
 
 void OcsServer::add_routes() {
   httplib::Server& s = *http_;
+  s.set_pre_routing_handler([](const httplib::Request&, httplib::Response&) {
+    yield_to_controller();  // the worker thread that handles this request
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
   s.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
     std::string what = "internal error";
     try {
