@@ -224,14 +224,17 @@ def main():
         for _ in range(3):
             events = stream_events(port, 2)
             check(len(events) == 2 and events[1]["t"] > events[0]["t"], "a stream client got 2 frames and left")
+        def wait_clients(predicate):
+            end = time.time() + 20
+            while not predicate(json.loads(http(port, "/api/info")[1])["clients"]) and time.time() < end:
+                time.sleep(0.1)
+        wait_clients(lambda n: n == 0)  # the streams that left are noticed at the next frame
         holders = []
         for _ in range(4):
             s = socket.create_connection(("127.0.0.1", port), timeout=5)
             s.sendall(b"GET /api/stream HTTP/1.1\r\nHost: x\r\n\r\n")
             holders.append(s)
-        end = time.time() + 20
-        while json.loads(http(port, "/api/info")[1])["clients"] < 4 and time.time() < end:
-            time.sleep(0.1)
+        wait_clients(lambda n: n >= 4)
         fifth = raw(port, b"GET /api/stream HTTP/1.1\r\nHost: x\r\n\r\n")
         check(fifth.startswith(b"HTTP/1.1 503"), "a fifth stream: 503")
         for s in holders:
