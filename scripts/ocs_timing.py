@@ -29,6 +29,8 @@ def main():
     ap.add_argument("--client", choices=["chromium", "stream"], default="chromium",
                     help="chromium: the page in a headless browser on this machine; stream: a reader of the "
                          "frame stream that draws nothing (the server's own cost)")
+    ap.add_argument("--browser-idle", action="store_true",
+                    help="run Chromium under SCHED_IDLE (chrt --idle 0), as one would on the car's own computer")
     ap.add_argument("sim_args", nargs="*")
     a = ap.parse_args()
     chromium = shutil.which("chromium")
@@ -49,7 +51,7 @@ def main():
     if a.client == "stream":
         stream_cycles(port, a.seconds, a.cycle)
     else:
-        browse(chromium, url, a.seconds, a.cycle)
+        browse(chromium, url, a.seconds, a.cycle, a.browser_idle)
     urllib.request.urlopen(urllib.request.Request(url + "/api/control", data=b"stop=1"), timeout=10)
     sim.wait(timeout=120)
     print(json.dumps(json.load(open(os.path.join(a.out, "ocs_timing.json"))), indent=2))
@@ -70,10 +72,11 @@ def stream_cycles(port, seconds, cycle):
         time.sleep(cycle)
 
 
-def browse(chromium, url, seconds, cycle):
+def browse(chromium, url, seconds, cycle, idle):
     env = dict(os.environ, DBUS_SESSION_BUS_ADDRESS="disabled:")
     # a browser that stays on the page until we end it (a DevTools port keeps headless Chromium open)
-    browser = subprocess.Popen([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+    prefix = ["chrt", "--idle", "0"] if idle else []
+    browser = subprocess.Popen([*prefix, chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
                                 "--window-size=1400,1150", "--remote-debugging-port=0",
                                 f"{url}/?cycle={cycle}"], env=env, stdout=subprocess.DEVNULL,
                                stderr=subprocess.DEVNULL)
