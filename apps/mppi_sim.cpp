@@ -10,11 +10,23 @@
 #include "mppi/error.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/summary.hpp"
+#ifdef MPPI_HAVE_OCS
+#include "ocs/serve.hpp"
+#endif
 
 int main(int argc, char** argv) {
   CLI::App app{"MPPI driving laps of a built-in track in the headless simulator.", "mppi-sim"};
   mppi::cli::SimCommandLine cl;
   mppi::cli::add_sim_options(app, cl);
+  int serve_port = -1;
+  bool serve_fast = false;
+  std::string replay_csv;
+  app.add_option("--serve", serve_port, "operator page on http://127.0.0.1:PORT/ while driving, in real time (docs/OCS.md)")
+      ->type_name("PORT")
+      ->check(CLI::Range(0, 65535));
+  app.add_flag("--fast", serve_fast, "with --serve: do not hold the simulation to wall-clock time");
+  app.add_option("--replay", replay_csv, "serve FILE (a recording) on the operator page for replay (with --serve PORT)")
+      ->type_name("FILE");
   if (const int rc = mppi::cli::parse(app, argc, argv, [&] { mppi::cli::finish_sim_options(app, cl); }); rc >= 0)
     return rc;
   if (cl.list_models) {
@@ -27,12 +39,34 @@ int main(int argc, char** argv) {
   }
   const mppi::sim::ClosedLoopConfig& config = cl.config;
   try {
+#ifdef MPPI_HAVE_OCS
+    mppi::ocs::ServeOptions serve;
+    serve.port = serve_port;
+    serve.realtime = !serve_fast;
+    if (!replay_csv.empty()) {
+      if (serve_port < 0) {
+        std::fprintf(stderr, "mppi-sim: --replay needs --serve PORT\n");
+        return 2;
+      }
+      return mppi::ocs::serve_recording(replay_csv, "", serve);
+    }
+#else
+    if (serve_port >= 0 || !replay_csv.empty()) {
+      std::fprintf(stderr, "mppi-sim: this build has no operator page (ocs/CMakeLists.txt says why)\n");
+      return 2;
+    }
+#endif
     if (config.progress)
       std::fprintf(stderr, "mppi-sim: %s track, model %s, plant %s, %.1f m/s, K = %d, T = %d, seed %llu\n",
                    config.track.c_str(), config.model.c_str(), config.plant.c_str(),
                    config.target_speed_mps, config.controller.num_samples, config.controller.horizon,
                    static_cast<unsigned long long>(config.controller.seed));
+#ifdef MPPI_HAVE_OCS
+    const mppi::sim::RunSummary summary =
+        serve_port >= 0 ? mppi::ocs::run_closed_loop_with_page(config, serve) : mppi::sim::run_closed_loop(config);
+#else
     const mppi::sim::RunSummary summary = mppi::sim::run_closed_loop(config);
+#endif
     if (config.progress)
       std::fprintf(stderr, "done: %d/%d laps, %d crashes, mean %.2f m/s, max %.2f m/s, optimizer p50 %.2f ms p99 %.2f ms -> %s\n",
                    summary.laps_completed, config.laps, summary.crashes, summary.mean_speed_mps,

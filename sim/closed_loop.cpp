@@ -23,6 +23,7 @@
 #include "sim/data_dir.hpp"
 #include "sim/geometry.hpp"
 #include "sim/lap_counter.hpp"
+#include "sim/path_predictor.hpp"
 #include "sim/recording.hpp"
 #include "sim/track_plot.hpp"
 
@@ -77,6 +78,7 @@ struct ControllerSetup {
   std::unique_ptr<Controller> controller;
   int model_states = 0;
   std::function<void(const float* plant_x, int plant_states, float* model_x)> observe;
+  PathPredictor predict;  // the controller model's paths, for an observer
 };
 
 // The controller on the backend the config asks for (mppi/make_controller.hpp).
@@ -100,6 +102,7 @@ ControllerSetup controller_setup(const ClosedLoopConfig& config, const M& model,
   setup.controller = build_controller(config, model, cost);
   setup.model_states = M::kNx;
   setup.observe = std::move(observe);
+  if (config.observer) setup.predict = make_path_predictor(model, config.controller.dt_s);
   return setup;
 }
 
@@ -185,7 +188,17 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   std::optional<chassis::SimChassis> chassis;
   if (config.through_chassis) chassis.emplace();
   std::size_t next_target = 0;  // next entry of target_speed_schedule
+  double target_speed_mps = config.target_speed_mps;
+  if (config.observer) config.observer->on_start(setup.predict);
   while (t < max_time && laps.laps_completed() < config.laps) {
+    if (config.observer) {
+      const OperatorRequests r = config.observer->poll_requests(t);
+      if (r.stop) break;
+      std::string why;
+      if (r.target_speed_mps && controller->set_cost_param("target_speed_mps", *r.target_speed_mps, &why))
+        target_speed_mps = *r.target_speed_mps;
+      if (r.motion_enabled && chassis) chassis->set_motion_enabled(*r.motion_enabled);
+    }
     const auto& schedule = config.target_speed_schedule;
     if (next_target < schedule.size() && t + 1e-9 >= schedule[next_target].first) {
       while (next_target + 1 < schedule.size() && t + 1e-9 >= schedule[next_target + 1].first) ++next_target;
@@ -193,6 +206,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
       std::string why;
       if (!controller->set_cost_param("target_speed_mps", schedule[next_target].second, &why))
         throw Error("target_speed_schedule entry " + std::to_string(next_target) + ": " + why);
+      target_speed_mps = schedule[next_target].second;
       ++next_target;
     }
     setup.observe(plant.state(), P::kNx, model_x.data());
@@ -244,6 +258,12 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
                                step_summary.min_cost};
       log->write(t, s, command, extras);
     }
+    if (config.observer)
+      config.observer->after_step({.t_s = t, .state = s, .model_state = model_x, .output = output,
+                                   .applied = plant.applied(), .summary = &step_summary, .controller = controller,
+                                   .chassis = chassis ? &*chassis : nullptr, .laps_completed = laps.laps_completed(),
+                                   .crashes = summary.crashes, .progress_m = laps.progress_m(),
+                                   .target_speed_mps = target_speed_mps});
     if (!std::isfinite(s.x_m) || !std::isfinite(s.vx_mps))
       throw Error("the plant state became non-finite at t = " + std::to_string(t) + " s");
     if (laps.laps_completed() > reported_laps && config.progress) {
@@ -254,6 +274,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
                    summary.crashes, t);
     }
   }
+  if (config.observer) config.observer->on_finish();
   summary.sim_time_s = t;
   summary.laps_completed = laps.laps_completed();
   summary.lap_times_s = laps.lap_times_s();

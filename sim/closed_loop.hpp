@@ -14,6 +14,7 @@
 #include "mppi/backend_choice.hpp"
 #include "mppi/controller_options.hpp"
 #include "sim/plant.hpp"
+#include "sim/step_observer.hpp"
 #include "sim/summary.hpp"
 #include "sim/track.hpp"
 
@@ -46,6 +47,7 @@ struct ClosedLoopConfig {
   bool progress = true;                   // print a line per lap to stderr
   bool through_chassis = true;            // controller -> chassis adapter (priorities, runstop,
                                           // watchdog, calibration) -> plant; false = direct
+  StepObserver* observer = nullptr;       // sees every step, brings the operator's requests
 };
 
 // Runs the loop; throws mppi::Error for bad settings or data files.

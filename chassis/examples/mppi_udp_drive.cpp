@@ -28,6 +28,10 @@
 #include "sim/data_dir.hpp"
 #include "sim/lap_counter.hpp"
 #include "sim/track.hpp"
+#ifdef MPPI_HAVE_OCS
+#include "ocs/loop_page.hpp"
+#include "sim/path_predictor.hpp"
+#endif
 
 namespace {
 
@@ -41,7 +45,7 @@ int main(int argc, char** argv) {
   using namespace mppi::chassis;
   std::string host = "127.0.0.1", name = "mppi", runstop_name = "OCS", model = models::AutoRallyNetworkModel::kName,
               track_name = "gazebo";
-  int port = udp::kDefaultPort, param_port = udp::kDefaultParameterPort;
+  int port = udp::kDefaultPort, param_port = udp::kDefaultParameterPort, serve_port = -1;
   double speed = 6.0, duration_s = 30.0;
   ControlLoopSettings loop_settings;
   ControllerOptions options;
@@ -69,6 +73,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 65535).description(""));
   std::string data_dir;
   cli::add_data_dir_option(app, data_dir);
+  app.add_option("--serve", serve_port, "operator page on http://127.0.0.1:PORT/ (docs/OCS.md)")
+      ->type_name("PORT")
+      ->check(CLI::Range(0, 65535).description(""));
   if (const int rc = cli::parse(app, argc, argv); rc >= 0) return rc;
   try {
     const sim::Track track = sim::Track::load(track_name);
@@ -79,12 +86,22 @@ int main(int argc, char** argv) {
     // Any registered model with its default data; it reads the chassis' common states.
     std::unique_ptr<Controller> controller;
     std::function<void(const float* common, float* model_x)> observe;
+#ifdef MPPI_HAVE_OCS
+    std::unique_ptr<ocs::LoopPage> page;  // --serve
+    StepSummary summary;
+#else
+    if (serve_port >= 0) throw Error("this build has no operator page (ocs/CMakeLists.txt says why)");
+#endif
     with_model(model, [&]<class D>() {
       const std::string default_file = D::kDefaultFile;
       const typename D::Model m = D::load(default_file.empty() ? default_file : sim::data_file(default_file));
       controller = std::make_unique<Controller>(make_cpu_controller(m, cost, options));
       loop_settings.state_size = D::Model::kNx;
       observe = [m](const float* common, float* model_x) { D::from_plant(m, common, state::kCommonStates, model_x); };
+#ifdef MPPI_HAVE_OCS
+      if (serve_port >= 0)
+        page = std::make_unique<ocs::LoopPage>(serve_port, track_name, sim::make_path_predictor(m, options.dt_s), speed);
+#endif
     });
 
     udp::UdpChassisClient commands(name, host, port);
@@ -126,7 +143,11 @@ int main(int argc, char** argv) {
     ControlLoop loop(
         loop_settings, clock,
         [&](std::span<float> x) {
+#ifdef MPPI_HAVE_OCS
+          runstop.send_runstop(!page || page->motion_allowed());  // the operator's heartbeat, every tick
+#else
           runstop.send_runstop(true);  // the operator's heartbeat, every tick
+#endif
           if (latest.try_take(&state_msg, &seen)) have_state = true, state_at = clock.now();
           // No state, or none for 0.1 s (the chassis is gone): publish nothing this tick.
           if (!have_state || clock.now() - state_at > seconds(0.1)) return false;
@@ -149,6 +170,16 @@ int main(int argc, char** argv) {
             }
             applying.clear();
           }
+#ifdef MPPI_HAVE_OCS
+          if (page) {
+            page->apply_requests(*controller);
+            const auto u = controller->step(x, &summary);
+            page->after_step(state_msg.time_s, VehicleState::from_array(state_msg.state.data()), x,
+                             {u[control::kSteer], u[control::kThrottle]}, {state_msg.applied[0], state_msg.applied[1]},
+                             summary, *controller, state_msg.motion_enabled, state_msg.watchdog_tripped);
+            return Command{u[control::kSteer], u[control::kThrottle], 0.f, actuator::kAll};
+          }
+#endif
           const auto u = controller->step(x);
           return Command{u[control::kSteer], u[control::kThrottle], 0.f, actuator::kAll};
         },
