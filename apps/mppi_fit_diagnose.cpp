@@ -49,6 +49,8 @@ const char* kUsage = R"(usage:
                           [--noise-scale F] [--nominal single-track|double-track|full-vehicle]
                           (default: the target speed changes every 2-6 s, uniform in 3:8 m/s;
                           --speed V holds it constant)
+  mppi-fit diagnose synth|sweep --generator independent ...   the independent evidence generator
+                          (docs/EVIDENCE.md; --generator independent --help lists its options)
   mppi-fit diagnose sweep [--seeds N] [--sizes small,large] [--effects A,B,...] [--clean N]
                           [--duration S] [--speed-range MIN:MAX | --speed V] [--min-bic-drop B]
                           [--nominal MODEL]  (truth base and diagnosed nominal; single-track)
@@ -361,9 +363,14 @@ int cmd_loop(int argc, char** argv) {
 
 }  // namespace
 
+bool mppi_fit_wants_independent_generator(int argc, char** argv);  // apps/mppi_fit_evidence.cpp
+int mppi_fit_evidence(int argc, char** argv);
+
 int mppi_fit_diagnose(int argc, char** argv) {
   try {
     const std::string sub = argc > 1 ? argv[1] : "";
+    if ((sub == "synth" || sub == "sweep") && mppi_fit_wants_independent_generator(argc, argv))
+      return mppi_fit_evidence(argc, argv);  // the independent evidence generator (docs/EVIDENCE.md)
     if (sub == "synth") return cmd_synth(argc, argv);
     if (sub == "sweep") return cmd_sweep(argc, argv);
     if (sub == "loop") return cmd_loop(argc, argv);

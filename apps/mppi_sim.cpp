@@ -35,6 +35,7 @@ const char* kUsage = R"(usage: mppi-sim [options]
   --plant-params FILE  the plant's data file (YAML parameters, or a corrected-model file)
   --model-params FILE  the controller model's data file (the same kinds)
   --network FILE       weights (.npz) of a learned model, when no --*-params file is given
+  --surface FILE       grip and elevation by place (YAML, docs/SURFACES.md; single-track plant)
   --out DIR            write DIR/log.csv, DIR/track.png, DIR/summary.json (default out/sim)
   --json               print summary.json to stdout
   --quiet              no progress lines
@@ -107,6 +108,7 @@ int main(int argc, char** argv) {
     else if (flag == "--plant-params") config.plant_params_yaml = value();
     else if (flag == "--model-params") config.model_params_yaml = value();
     else if (flag == "--network") config.network_npz = value();
+    else if (flag == "--surface") config.surface_yaml = value();
     else if (flag == "--out") config.out_dir = value();
     else if (flag == "--json") print_json = true;
     else if (flag == "--quiet") config.progress = false;
