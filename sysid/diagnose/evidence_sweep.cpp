@@ -66,22 +66,33 @@ EvidenceGrid reduced_evidence_grid() {
 
 std::vector<EvidenceCase> evidence_cases(const EvidenceGrid& g) {
   using evidence::truth_effect_catalogue;
-  std::vector<EvidenceCase> out;
+  std::vector<EvidenceCase> single, pairs, clean;
   for (const auto& name : g.effects) evidence::truth_effect_info(name);  // throws for unknown names
-  for (const auto& info : truth_effect_catalogue()) {
-    if (!g.effects.empty() && std::find(g.effects.begin(), g.effects.end(), info.name) == g.effects.end()) continue;
-    for (const auto& size : g.sizes) {
-      if (size != "small" && size != "large") throw Error("evidence sweep: sizes are small and large, not '" + size + "'");
-      for (int s = 1; s <= g.seeds; ++s) out.push_back({{info.name}, size, size == "small" ? info.small : info.large, s});
+  for (const auto& size : g.sizes)
+    if (size != "small" && size != "large") throw Error("evidence sweep: sizes are small and large, not '" + size + "'");
+  for (int s = 1; s <= g.seeds; ++s)
+    for (const auto& size : g.sizes)
+      for (const auto& info : truth_effect_catalogue()) {
+        if (!g.effects.empty() && std::find(g.effects.begin(), g.effects.end(), info.name) == g.effects.end()) continue;
+        single.push_back({{info.name}, size, size == "small" ? info.small : info.large, s});
+      }
+  const int n_pairs = std::min<int>(g.pairs, static_cast<int>(pair_list().size()));
+  for (int s = 1; s <= g.seeds; ++s)
+    for (int i = 0; i < n_pairs; ++i) {
+      const auto& [a, b] = pair_list()[static_cast<std::size_t>(i)];
+      pairs.push_back({{a, b}, "pair", evidence::truth_effect_info(a).large + "," + evidence::truth_effect_info(b).large, s});
     }
+  for (int s = 1; s <= g.clean; ++s) clean.push_back({{}, "clean", "", 100 + s});
+  // Interleaved (seed-major): a sweep cut short still has every kind of case in it.
+  std::vector<EvidenceCase> out;
+  std::size_t i = 0, j = 0, k = 0;
+  const std::size_t total = single.size() + pairs.size() + clean.size();
+  const std::size_t every = std::max<std::size_t>(1, single.size() / std::max<std::size_t>(1, clean.size() + pairs.size()));
+  while (out.size() < total) {
+    for (std::size_t n = 0; n < every && i < single.size(); ++n) out.push_back(single[i++]);
+    if (k < clean.size() && (k <= j || j >= pairs.size())) out.push_back(clean[k++]);
+    else if (j < pairs.size()) out.push_back(pairs[j++]);
   }
-  const int pairs = std::min<int>(g.pairs, static_cast<int>(pair_list().size()));
-  for (int i = 0; i < pairs; ++i) {
-    const auto& [a, b] = pair_list()[static_cast<std::size_t>(i)];
-    for (int s = 1; s <= g.seeds; ++s)
-      out.push_back({{a, b}, "pair", evidence::truth_effect_info(a).large + "," + evidence::truth_effect_info(b).large, s});
-  }
-  for (int s = 1; s <= g.clean; ++s) out.push_back({{}, "clean", "", 100 + s});
   return out;
 }
 

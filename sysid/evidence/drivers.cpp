@@ -57,9 +57,9 @@ double Driver::target_speed(const DriverView& v, double arc_m) {
       schedule_speed_ = speed_min_ + (speed_max_ - speed_min_) * uni(rng_);
       schedule_until_s_ = v.t_s + 2 + 4 * uni(rng_);
     }
-    // Bold, but not blind: the schedule is capped where the curvature ahead asks 7 m/s^2.
+    // Bold, but not blind: the schedule is capped where the curvature ahead asks 5 m/s^2.
     const double kappa = curvature_ahead(arc_m, 3 + 1.2 * v.speed_mps);
-    return kappa > 1e-4 ? std::max(speed_min_, std::min(schedule_speed_, std::sqrt(7.0 / kappa))) : schedule_speed_;
+    return kappa > 1e-4 ? std::max(speed_min_, std::min(schedule_speed_, std::sqrt(5.0 / kappa))) : schedule_speed_;
   }
   if (v.t_s >= nerve_until_s_) {  // a human's daring changes from stretch to stretch
     nerve_mps2_ = 2.5 + 3.0 * uni(rng_);
@@ -81,7 +81,7 @@ std::pair<double, double> Driver::command(const DriverView& v) {
   const double s = arc[cp.segment] + cp.t * (arc[cp.segment + 1] - arc[cp.segment]);
 
   // Pure pursuit to a point lookahead metres further along the centreline.
-  const double lookahead = (kind_ == "human" ? 2.5 : 1.8) + 0.35 * v.speed_mps;
+  const double lookahead = (kind_ == "human" ? 2.5 : 1.2) + 0.25 * v.speed_mps;
   const double length = track_.length_m();
   double target_s = std::fmod(s + lookahead, length);
   const auto it = std::upper_bound(arc.begin(), arc.end(), target_s);
