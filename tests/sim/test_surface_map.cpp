@@ -136,13 +136,13 @@ TEST_CASE("surface plant: on a low-grip patch the tyre force is capped at mu_pea
   const SingleTrackOnSurface car(p, map);
   const double mu_peak = p.tyre.D + p.tyre.Sv;  // sin(.) <= 1
   // Sliding hard sideways at 6 m/s: both tyres far beyond their peak slip.
-  double x[SingleTrack::kNx] = {0, 0, 0, 6.0, 3.0, 0.5, 0, 6.0 / p.wheel_radius_m, 6.0 / p.wheel_radius_m};
+  double x[SingleTrack::kNx] = {0, 0, 0, 6.0, 5.0, 0.5, 0, 6.0 / p.wheel_radius_m, 6.0 / p.wheel_radius_m};
   const double u[2] = {0.5, 0.0};
   const SingleTrackForces on = car.forces(x, u);
   for (const auto [fx, fy, fz] : {std::tuple{on.front_fx_N, on.front_fy_N, on.front_fz_N},
                                   std::tuple{on.rear_fx_N, on.rear_fy_N, on.rear_fz_N}}) {
     CHECK(std::hypot(fx, fy) <= mu_peak * 0.4 * fz + 1e-9);
-    CHECK(std::hypot(fx, fy) >= 0.9 * 0.4 * fz);  // saturated: near the cap
+    CHECK(std::hypot(fx, fy) >= 0.75 * mu_peak * 0.4 * fz);  // sliding: near the cap
   }
   x[state::kX] = 10.0;  // the same slide off the patch: the full tyre
   const SingleTrackForces off = car.forces(x, u);

@@ -174,9 +174,12 @@ TEST_CASE("evidence: a grade adds -g sin(theta) along the slope and nothing acro
         Approx(-c.gravity_mps2 * std::sin(theta)).epsilon(1e-12));
   // Rolling up a constant grade the car (with its wheels) decelerates at m g sin(theta) / m_eff.
   const double m_eff = c.mass_kg + (c.front_wheel_inertia_kgm2 + c.rear_wheel_inertia_kgm2) / (c.wheel_radius_m * c.wheel_radius_m);
+  // (after the first second: the tyres need a little slip before they slow the wheels)
   CarState x = rolling(6.0, c);
-  for (int i = 0; i < 2000; ++i) x = rk4_step(c, x, hill, 0.001);
-  CHECK((6.0 - x[kVx]) / 2.0 == Approx(c.mass_kg * c.gravity_mps2 * std::sin(theta) / m_eff).epsilon(0.01));
+  for (int i = 0; i < 1000; ++i) x = rk4_step(c, x, hill, 0.001);
+  const double v1 = x[kVx];
+  for (int i = 0; i < 1000; ++i) x = rk4_step(c, x, hill, 0.001);
+  CHECK(v1 - x[kVx] == Approx(c.mass_kg * c.gravity_mps2 * std::sin(theta) / m_eff).epsilon(0.01));
 }
 
 TEST_CASE("evidence: the battery's motor torque solves its own voltage equation", "[evidence]") {
