@@ -27,6 +27,7 @@ const char* kEvidenceUsage = R"(usage:
         writes FILE.csv, FILE.clean.csv (noise-free), FILE.truth.json (effects, sizes, table ids)
   mppi-fit diagnose sweep --generator independent [--reduced] [--seeds N] [--sizes small,large]
         [--effects A,B] [--pairs N] [--clean N] [--duration S] [--jobs N] [--out DIR] [--md FILE]
+        [--summarize DIR]  (only the table, from DIR/runs.jsonl of a sweep, finished or not)
         (full grid: 5 seeds, every effect at both sizes, 8 pairs, 20 effect-free; --reduced: 1 seed,
         3 pairs, 4 effect-free). Writes DIR/runs.jsonl, DIR/evidence_sweep.md, DIR/evidence_sweep.json.
 Effects (key=value keys are the fields of sysid/evidence/truth_effects.hpp):
@@ -106,7 +107,7 @@ int evidence_sweep(int argc, char** argv) {
   int seeds = -1, pairs = -1, clean = -1, jobs = 1;
   std::vector<std::string> sizes, effects;
   double duration = 60;
-  std::string out = "out/evidence_sweep", md_copy;
+  std::string out = "out/evidence_sweep", md_copy, summarize;
   for (int i = 2; i < argc; ++i) {
     const std::string f = argv[i];
     auto value = [&]() -> std::string {
@@ -124,10 +125,20 @@ int evidence_sweep(int argc, char** argv) {
     else if (f == "--jobs") jobs = std::max(1, static_cast<int>(number(f, value())));
     else if (f == "--out") out = value();
     else if (f == "--md") md_copy = value();
+    else if (f == "--summarize") summarize = value();
     else if (f == "--help" || f == "-h") {
       std::fputs(usage().c_str(), stdout);
       return 0;
     } else throw UsageError("unknown option " + f);
+  }
+  if (!summarize.empty()) {  // the table from a (possibly unfinished) sweep's runs.jsonl
+    const auto runs = diagnose::read_evidence_runs(summarize + "/runs.jsonl");
+    const std::string md = diagnose::evidence_summary_markdown(runs);
+    std::printf("%s", md.c_str());
+    std::ofstream(summarize + "/evidence_sweep.md") << md;
+    std::ofstream(summarize + "/evidence_sweep.json") << diagnose::evidence_summary_json(runs) << "\n";
+    if (!md_copy.empty()) std::ofstream(md_copy) << md;
+    return 0;
   }
   if (reduced) grid = diagnose::reduced_evidence_grid();
   if (seeds >= 0) grid.seeds = seeds;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -170,6 +171,43 @@ std::string evidence_run_json(const EvidenceRun& r) {
   j["corrected_worse"] = r.corrected_worse();
   if (!r.error.empty()) j["error"] = r.error;
   return j.dump();
+}
+
+std::vector<EvidenceRun> read_evidence_runs(const std::string& jsonl_path) {
+  std::ifstream in(jsonl_path);
+  if (!in) throw Error(jsonl_path + ": cannot open");
+  std::vector<EvidenceRun> runs;
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    if (line.empty()) continue;
+    try {
+      const auto j = nlohmann::json::parse(line);
+      EvidenceRun r;
+      r.c.effects = j.at("effects").get<std::vector<std::string>>();
+      r.c.size = j.at("size");
+      r.c.seed = j.at("seed");
+      r.c.assignments = j.at("assignments");
+      r.track = j.at("track");
+      r.direction = j.at("direction");
+      r.driver = j.at("driver");
+      r.crashes = j.at("crashes");
+      r.named = j.at("named").get<std::vector<std::string>>();
+      r.suspected = j.at("suspected").get<std::vector<std::string>>();
+      r.acceptable = j.at("acceptable_ids").get<std::vector<std::string>>();
+      r.out_of_library = j.at("out_of_library");
+      r.right = j.at("right");
+      r.wrong = j.at("wrong");
+      r.before_clean = j.at("heldout_1s_nrmse_clean_before");
+      r.after_clean = j.at("heldout_1s_nrmse_clean_after");
+      if (j.contains("error")) r.error = j.at("error");
+      runs.push_back(r);
+    } catch (const nlohmann::json::exception& e) {
+      throw Error(jsonl_path + ":" + std::to_string(n) + ": " + e.what());
+    }
+  }
+  return runs;
 }
 
 namespace {

@@ -50,6 +50,9 @@ EvidenceRun run_evidence_case(const EvidenceCase& c, const std::string& dir, dou
                               const DiagnoseOptions& o);
 
 std::string evidence_run_json(const EvidenceRun& r);
+// The runs of a runs.jsonl (one evidence_run_json line each; a sweep cut short is summarised
+// from what it finished). Throws mppi::Error naming the file and line for a malformed line.
+std::vector<EvidenceRun> read_evidence_runs(const std::string& jsonl_path);
 // The table (per effect and size) and the totals against the bars, in Markdown.
 std::string evidence_summary_markdown(const std::vector<EvidenceRun>& runs);
 std::string evidence_summary_json(const std::vector<EvidenceRun>& runs);
