@@ -11,6 +11,8 @@
 
 #include "dynamics/single_track.hpp"
 #include "mppi/error.hpp"
+#include "sim/closed_loop.hpp"
+#include "sim/recording.hpp"
 #include "sim/surface_map.hpp"
 #include "sim/surface_plant.hpp"
 #include "test_data.hpp"
@@ -159,4 +161,24 @@ TEST_CASE("surface maps: the shipped examples load", "[surface]") {
   CHECK(b.grip(-15.0, 0.0) == Approx(1.0).margin(0.01));
   CHECK(b.grip(3.0, 0.0) == Approx(0.6).margin(0.01));
   CHECK(b.slope(0.0, 0.0).x == Approx(0.03));
+}
+
+TEST_CASE("closed loop on a surface map: drives, logs the surface, refuses plants without tyres to scale", "[surface]") {
+  ClosedLoopConfig c;
+  c.model = "single-track";
+  c.plant = "single-track";
+  c.surface_yaml = test::data_path("surfaces/gazebo_wet_patches.yaml");
+  c.controller.num_samples = 64;
+  c.controller.horizon = 30;
+  c.controller.num_threads = 1;
+  c.max_time_s = 3.0;
+  c.laps = 1;
+  c.progress = false;
+  c.out_dir = (std::filesystem::temp_directory_path() / "mppi_surface_loop").string();
+  const RunSummary s = run_closed_loop(c);
+  CHECK(s.mean_speed_mps > 0.5);
+  const Recording rec = RecordingReader::read(c.out_dir + "/log.csv");
+  CHECK(rec.metadata.at("surface") == c.surface_yaml);
+  c.plant = "kinematic";
+  CHECK_THROWS_WITH(run_closed_loop(c), Catch::Contains("needs the single-track plant"));
 }
