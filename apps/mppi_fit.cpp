@@ -22,7 +22,16 @@ int FitCommands::run() const {
   return mppi::cli::kUsageExit;
 }
 
+bool mppi_fit_wants_independent_generator(int argc, char** argv);  // apps/mppi_fit_evidence.cpp
+int mppi_fit_evidence(int argc, char** argv);
+
 int main(int argc, char** argv) {
+  // `diagnose synth|sweep --generator independent`: the independent evidence generator has its own
+  // options (docs/EVIDENCE.md) and is kept apart from the diagnosis' code.
+  if (argc >= 3 && std::string(argv[1]) == "diagnose" &&
+      (std::string(argv[2]) == "synth" || std::string(argv[2]) == "sweep") &&
+      mppi_fit_wants_independent_generator(argc - 1, argv + 1))
+    return mppi_fit_evidence(argc - 1, argv + 1);
   CLI::App app{"Parameter estimation and sim-vs-real tools (mppi-fit <command> --help for its options).", "mppi-fit"};
   mppi::cli::configure(app);
   // (the command is required by FitCommands::run, so that an unknown flag is named first)

@@ -344,7 +344,17 @@ void add_diagnose_options(CLI::App& cmd, DiagnoseArgs& a) {
   cmd.add_flag("--no-plots", a.no_plots, "skip the PNG plots");
 }
 
+// `--generator independent` is taken before parsing (apps/mppi_fit.cpp): listed here for --help.
+void add_generator_note(CLI::App& cmd) {
+  cmd.add_option_function<std::string>(
+         "--generator", [](const std::string&) { throw CLI::ValidationError("--generator", "only 'independent'"); },
+         "independent: the independent evidence generator, with its own options (docs/EVIDENCE.md; "
+         "--generator independent --help lists them)")
+      ->type_name("NAME");
+}
+
 void add_synth_options(CLI::App& cmd, SynthArgs& a) {
+  add_generator_note(cmd);
   cmd.add_option("--out", a.out, "the recording to write (required)")->type_name("FILE.csv");
   cmd.add_option("--effect", a.effect, "hidden effects and their values")->type_name("key=value,...");
   mppi::cli::add_seed_option(cmd, a.o.seed, "MPPI and noise seed");
@@ -357,6 +367,7 @@ void add_synth_options(CLI::App& cmd, SynthArgs& a) {
 }
 
 void add_sweep_options(CLI::App& cmd, SweepArgs& a) {
+  add_generator_note(cmd);
   cmd.add_option("--seeds", a.seeds, "seeds per effect and size")->type_name("N");
   cmd.add_option("--sizes", a.sizes, "effect sizes")->type_name("small,large");
   cmd.add_option("--effects", a.effects, "effect ids (default: all the sweep's cases)")->type_name("A,B,...");

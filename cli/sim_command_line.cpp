@@ -50,6 +50,8 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
       ->type_name("FILE");
   app.add_option("--network", c.network_npz, "weights (.npz) of a learned model, when no --*-params file is given")
       ->type_name("FILE");
+  app.add_option("--surface", c.surface_yaml, "grip and elevation by place (YAML, docs/SURFACES.md; single-track plant)")
+      ->type_name("FILE");
   add_out_option(app, c.out_dir, "write DIR/log.csv, DIR/track.png, DIR/summary.json");
   app.add_flag("--json", cl.print_json, "print summary.json to stdout");
   app.add_flag("--quiet", cl.quiet, "no progress lines");

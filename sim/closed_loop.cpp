@@ -1,4 +1,5 @@
 #include "sim/closed_loop.hpp"
+#include "sim/surface_plant.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -163,7 +164,8 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
         std::vector<std::pair<std::string, std::string>>{
             {"source", "mppi-sim"}, {"track", track.name()}, {"model", config.model},
             {"plant", config.plant}, {"seed", std::to_string(config.controller.seed)},
-            {"target_speed_mps", std::to_string(config.target_speed_mps)}});
+            {"target_speed_mps", std::to_string(config.target_speed_mps)},
+            {"surface", config.surface_yaml.empty() ? "flat" : config.surface_yaml}});
   }
 
   RunSummary summary;
@@ -316,6 +318,14 @@ RunSummary run_closed_loop(const ClosedLoopConfig& config) {
         (i > 0 && from_s < config.target_speed_schedule[i - 1].first))
       throw Error("target_speed_schedule entry " + std::to_string(i) +
                   ": times must be finite and ascending, speeds finite");
+  }
+  if (!config.surface_yaml.empty()) {
+    if (config.plant != models::SingleTrackModel::kName)
+      throw Error("a surface map (" + config.surface_yaml + ") needs the single-track plant, not '" + config.plant + "'");
+    auto surface = std::make_shared<const SurfaceMap>(SurfaceMap::load(config.surface_yaml));
+    const SingleTrackParams params =
+        load_single_track_params(model_file<models::SingleTrackModel>(config.plant_params_yaml, config.network_npz));
+    return run_with_plant(config, SingleTrackOnSurface(params, std::move(surface)), track, cost);
   }
   if (config.plant == kCorrectedModel)
     return visit_corrected(config.plant_params_yaml, "plant", [&](const auto& model, auto) {

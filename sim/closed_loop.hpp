@@ -41,6 +41,9 @@ struct ClosedLoopConfig {
   std::string plant_params_yaml;          // plant's data file; empty = its default (data/config)
   std::string model_params_yaml;          // controller model's data file; empty = its default
   std::string network_npz;                // weights (npz) for learned models; empty = the shipped ones
+  // Grip and elevation by place (sim/surface_map.hpp, docs/SURFACES.md); empty = flat, grip 1.
+  // Needs the single-track plant.
+  std::string surface_yaml;
   ActuatorLimits actuators;               // plant actuator limits
   double plant_dt_s = 0.002;              // plant integration step (500 Hz)
   std::string out_dir;                    // log.csv, track.png, summary.json; empty = none

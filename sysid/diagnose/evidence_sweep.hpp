@@ -1,0 +1,60 @@
+#pragma once
+// The diagnosis judged on the independent evidence generator (sysid/evidence): per hidden effect
+// (or pair, or none) and seed, a recording of that generator, the diagnosis with only the
+// recording and the nominal model, and the judgement with the generator's truth file and
+// noise-free states. The generator itself never sees this file's includes.
+#include <string>
+#include <vector>
+
+#include "sysid/diagnose/diagnose.hpp"
+#include "sysid/evidence/generator.hpp"
+
+namespace mppi::diagnose {
+
+struct EvidenceCase {
+  std::vector<std::string> effects;  // catalogue names (empty = effect-free)
+  std::string size;                  // small | large | pair | clean
+  std::string assignments;           // key=value,... of TruthEffects
+  int seed = 1;
+  std::string label() const;         // e.g. "steer_delay_large_s3"
+};
+
+struct EvidenceRun {
+  EvidenceCase c;
+  std::string track, direction, driver;
+  int crashes = 0;
+  std::vector<std::string> named, suspected, acceptable;  // acceptable: ids of the truth effects
+  bool out_of_library = false;   // every hidden effect is outside the library
+  bool right = false;            // every in-library effect named by an acceptable id (out of library: nothing named)
+  bool wrong = false;            // an id named that no hidden effect accounts for
+  double before_clean = 0, after_clean = 0;  // held-out normalised 1-s RMSE against the noise-free states
+  double reduction() const { return before_clean > 0 ? 1 - after_clean / before_clean : 0; }
+  bool corrected_worse() const { return after_clean > before_clean * 1.001; }
+  std::string error;             // a run that failed (generator or diagnosis), not scored
+};
+
+struct EvidenceGrid {
+  int seeds = 5;
+  std::vector<std::string> sizes = {"small", "large"};
+  std::vector<std::string> effects;  // empty = every catalogue effect
+  int pairs = 8;                     // 2-effect combinations (large sizes), from a fixed list
+  int clean = 20;                    // effect-free recordings
+  double duration_s = 60;
+};
+// The reduced grid: 1 seed, both sizes, 3 pairs, 4 effect-free recordings.
+EvidenceGrid reduced_evidence_grid();
+std::vector<EvidenceCase> evidence_cases(const EvidenceGrid& g);
+
+// Generates (unless the recording exists) and diagnoses one case; never throws (error set).
+EvidenceRun run_evidence_case(const EvidenceCase& c, const std::string& dir, double duration_s,
+                              const DiagnoseOptions& o);
+
+std::string evidence_run_json(const EvidenceRun& r);
+// The runs of a runs.jsonl (one evidence_run_json line each; a sweep cut short is summarised
+// from what it finished). Throws mppi::Error naming the file and line for a malformed line.
+std::vector<EvidenceRun> read_evidence_runs(const std::string& jsonl_path);
+// The table (per effect and size) and the totals against the bars, in Markdown.
+std::string evidence_summary_markdown(const std::vector<EvidenceRun>& runs);
+std::string evidence_summary_json(const std::vector<EvidenceRun>& runs);
+
+}  // namespace mppi::diagnose

@@ -1,0 +1,55 @@
+#pragma once
+// The independent evidence generator: the evidence car (car_physics.hpp) with hidden effects in
+// their own forms (truth_effects.hpp, actuators.hpp), on a surface (grip patches, a hill),
+// driven by a pursuit or human-like driver (drivers.hpp) round one of the three tracks in either
+// direction, with crashes and respawns, sensor noise and glitches. It writes
+//   FILE.csv        the recording (docs/RECORDING_FORMAT.md; commands sent at t, held to the
+//                   next row: "command timing" of real recordings)
+//   FILE.clean.csv  the same rows without noise and glitches (sensor faults kept: they are
+//                   what the sensors show, not noise)
+//   FILE.truth.json the effects, their sizes and forms, and the effect-table ids a diagnosis may
+//                   name for each ("out of library" where none exists)
+// It shares no code with the diagnosis' candidate terms or their effect table (docs/EVIDENCE.md;
+// a test checks its includes).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sysid/evidence/truth_effects.hpp"
+
+namespace mppi::evidence {
+
+struct EvidenceNoise {
+  double position_m = 0.03, yaw_rad = 0.008, vx_mps = 0.04, vy_mps = 0.04, yaw_rate_radps = 0.015;
+  double scale = 1;               // x all of the above (0 = none)
+  double glitch_rate = 0.002;     // per row: a one-row spike in one channel
+  double drop_rate = 0.001;       // per row: the row is missing from the file
+};
+
+struct EvidenceOptions {
+  TruthEffects truth;
+  std::vector<std::string> truth_names;  // catalogue names (truth_effects.hpp)
+  std::uint64_t seed = 1;
+  double duration_s = 60;
+  std::string track;       // gazebo | marietta | ccrf; empty = by seed
+  std::string direction;   // ccw | cw; empty = by seed
+  std::string driver;      // pursuit | human; empty = by seed
+  double speed_min_mps = 3, speed_max_mps = 8;
+  std::string vehicle_yaml;  // vehicle constants; empty = data/config/autorally_single_track.yaml
+  EvidenceNoise noise;
+  double physics_dt_s = 0.001, log_dt_s = 0.02;
+};
+
+struct EvidenceResult {
+  std::string csv, clean_csv, truth_json, track, direction, driver;
+  int crashes = 0, rows = 0;
+};
+
+// Throws mppi::Error for bad options or an unwritable path. Deterministic in the options.
+EvidenceResult generate_evidence(const EvidenceOptions& o, const std::string& csv_path);
+
+// FILE.csv -> FILE.clean.csv / FILE.truth.json
+std::string clean_path_of(const std::string& csv_path);
+std::string truth_path_of(const std::string& csv_path);
+
+}  // namespace mppi::evidence

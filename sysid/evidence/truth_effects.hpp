@@ -1,0 +1,58 @@
+#pragma once
+// The hidden effects of the evidence generator, each in its own physical form, with neutral
+// defaults (= no effect). Their names, sizes and the effect-table ids a diagnosis may
+// reasonably answer with are listed by truth_effect_catalogue().
+#include <string>
+#include <vector>
+
+namespace mppi::evidence {
+
+struct TruthEffects {
+  // Actuators (normalised commands in [-1, 1]).
+  double steer_delay_s = 0;       // exact FIFO delay of the steering command
+  double throttle_delay_s = 0;    // exact FIFO delay of the throttle command
+  double steer_rate_per_s = 0;    // servo rate limit |d steer / dt| (0 = none)
+  double steer_backlash = 0;      // play width between servo and wheels (normalised)
+  double steer_gain = 1, steer_offset = 0, steer_cubic = 0;  // s -> g s + k s^3 + b
+  double throttle_gain = 1;       // ESC gain
+  // Battery: terminal voltage = V_oc (1 - capacity_sag q / q_ref) - R I, with R I at stall
+  // current = internal_resistance_fraction of V_nominal; q the charge used (stall-current
+  // seconds), q_ref = 60 s. The motor torque follows the voltage.
+  double battery_internal_resistance_fraction = 0;
+  double battery_capacity_sag = 0;
+  // Chassis and environment.
+  double extra_drag_kgpm = 0;     // -c |v| v along the velocity vector
+  double front_rolling_coefficient = 0, rear_rolling_coefficient = 0;  // per axle, x its load
+  double payload_mass_scale = 1, payload_yaw_inertia_scale = 1;
+  double grade = 0;               // a hill: constant grade dz/dx of the whole ground plane
+  // Grip patches: `grip_patches` discs of grip `grip_patch_scale` on the track (0 = none).
+  int grip_patches = 0;
+  double grip_patch_scale = 1;
+  // Sensors.
+  double gyro_bias_radps = 0;     // the gyro reads r + b
+  double speed_sensor_scale = 1;  // the velocity sensor reads s (vx, vy)
+  double sensor_time_offset_s = 0;  // states stamped this much against the commands (row at t holds the state of t - offset)
+};
+
+// One effect of the catalogue: its key (a TruthEffects field set through set_truth_effect),
+// the effect-table ids of dynamics/effects.hpp a diagnosis may name for it ("out of library"
+// = none exists: the right answer is naming nothing reliable, or a "suspected" note), and
+// whether it is a sensor fault.
+struct TruthEffectInfo {
+  std::string name;                     // e.g. "steer_delay"
+  std::vector<std::string> keys;        // TruthEffects fields it sets
+  std::vector<std::string> table_ids;   // acceptable ids; empty = out of library
+  std::string form;                     // how it acts here, for the truth file
+  std::string small, large;             // sweep sizes "key=value,..." (small = barely visible)
+};
+const std::vector<TruthEffectInfo>& truth_effect_catalogue();
+const TruthEffectInfo& truth_effect_info(const std::string& name);  // throws mppi::Error
+
+// Sets a field by name ("steer_delay_s=0.08,grade=0.05"); returns the catalogue names of the
+// effects touched. Throws mppi::Error for an unknown key or a bad number.
+std::vector<std::string> set_truth_effects(const std::string& assignments, TruthEffects* e);
+
+// Field by name (for the truth file).
+double truth_effect_value(const TruthEffects& e, const std::string& key);
+
+}  // namespace mppi::evidence

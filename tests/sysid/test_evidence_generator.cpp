@@ -1,0 +1,243 @@
+// The independent evidence generator (sysid/evidence) against closed forms: a pure delay shifts
+// the response exactly, a servo rate limit bounds the steering slope, drag along the velocity
+// vector follows the v^2 law, a grade adds g sin(theta), the battery's torque solves its own
+// voltage equation; recordings are reproducible by seed; and the generator's sources include
+// nothing of the diagnosis it is evidence for.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "sim/recording.hpp"
+#include "sysid/evidence/actuators.hpp"
+#include "sysid/evidence/car_physics.hpp"
+#include "sysid/evidence/generator.hpp"
+#include "test_data.hpp"
+
+using namespace mppi;
+using namespace mppi::evidence;
+
+namespace {
+
+CarConstants frictionless_straight() {
+  CarConstants c;
+  c.rolling_coefficient = 0;
+  c.aero_drag_kgpm = 0;
+  return c;
+}
+
+CarState rolling(double vx, const CarConstants& c) {
+  CarState s{};
+  s[kVx] = vx;
+  s[kWf] = s[kWr] = vx / c.wheel_radius_m;
+  return s;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+TEST_CASE("evidence: a pure delay line returns the command issued exactly `delay` earlier", "[evidence]") {
+  DelayLine plain(0.0), delayed(0.06);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<double> issued;
+  for (int k = 0; k < 100; ++k) {
+    const double v = u(rng);
+    issued.push_back(v);
+    plain.issue(0.02 * k, v);
+    delayed.issue(0.02 * k, v);
+  }
+  for (int i = 0; i < 1900; ++i) {  // 1 ms grid
+    const double t = 0.001 * i;
+    const double expect = t < 0.06 - 1e-9 ? 0.0 : issued[static_cast<std::size_t>(std::floor((t - 0.06) / 0.02 + 1e-9))];
+    REQUIRE(delayed.value(t) == expect);
+    (void)plain.value(t);
+  }
+}
+
+TEST_CASE("evidence: with a pure steering and throttle delay the car's response is the undelayed one shifted exactly", "[evidence]") {
+  const CarConstants c;
+  auto drive = [&](double delay_s, std::vector<CarState>* out) {
+    TruthEffects e;
+    e.steer_delay_s = e.throttle_delay_s = delay_s;
+    ActuatorChain chain(e, c);
+    CarState s{};
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (int k = 0; k < 150; ++k) {
+      chain.issue(0.02 * k, 0.6 * u(rng), 0.3 + 0.4 * u(rng));
+      for (int i = 0; i < 20; ++i) {
+        const double t = 0.02 * k + 0.001 * i;
+        const auto [angle, torque] = chain.step(t, 0.001, s[kWr] * c.wheel_radius_m);
+        CarInputs in;
+        in.wheel_angle_rad = angle;
+        in.motor_torque_Nm = torque;
+        s = rk4_step(c, s, in, 0.001);
+        out->push_back(s);
+      }
+    }
+  };
+  std::vector<CarState> plain, delayed;
+  drive(0.0, &plain);
+  drive(0.08, &delayed);
+  const std::size_t shift = 80;  // 0.08 s at 1 ms
+  for (std::size_t i = 0; i < shift; ++i) REQUIRE(delayed[i][kVx] == 0.0);  // at rest until the first command arrives
+  double worst = 0;
+  for (std::size_t i = 0; i + shift < plain.size(); ++i)
+    for (int j = 0; j < 8; ++j) worst = std::max(worst, std::abs(delayed[i + shift][static_cast<std::size_t>(j)] - plain[i][static_cast<std::size_t>(j)]));
+  CHECK(worst < 1e-9);
+  CHECK(plain.back()[kVx] > 1.0);  // it did drive
+}
+
+TEST_CASE("evidence: a servo rate limit bounds the steering slope and slews full lock in 2 / rate seconds", "[evidence]") {
+  TruthEffects e;
+  e.steer_rate_per_s = 2.5;
+  const CarConstants c;
+  ActuatorChain chain(e, c);
+  double previous = 0, max_slope = 0;
+  double reached_at = -1;
+  chain.issue(0.0, -1, 0);
+  chain.issue(1.0, 1, 0);
+  for (int i = 0; i < 3000; ++i) {
+    const double t = 0.001 * i;
+    chain.step(t, 0.001, 0);
+    const double s = chain.servo_position();
+    max_slope = std::max(max_slope, std::abs(s - previous) / 0.001);
+    if (reached_at < 0 && t >= 1.0 && s >= 1 - 1e-12) reached_at = t;
+    previous = s;
+  }
+  CHECK(max_slope <= 2.5 + 1e-9);
+  CHECK(max_slope >= 2.5 - 1e-9);
+  CHECK(reached_at == Approx(1.0 + 2.0 / 2.5).margin(0.0015));
+}
+
+TEST_CASE("evidence: backlash holds the wheels while the servo moves inside the play", "[evidence]") {
+  double out = 0;
+  out = backlash(out, 0.04, 0.1);
+  CHECK(out == 0.0);  // inside +-0.05
+  out = backlash(out, 0.2, 0.1);
+  CHECK(out == Approx(0.15));  // dragged by the edge
+  out = backlash(out, 0.12, 0.1);
+  CHECK(out == Approx(0.15));  // reversing: the play is crossed first
+  out = backlash(out, 0.0, 0.1);
+  CHECK(out == Approx(0.05));
+}
+
+TEST_CASE("evidence: drag along the velocity vector is -c |v| v and a coasting car follows v0 / (1 + c v0 t / m_eff)", "[evidence]") {
+  const CarConstants c = frictionless_straight();
+  CarInputs with, without;
+  with.extra_drag_kgpm = 0.6;
+  CarState s = rolling(4.0, c);
+  s[kVy] = 1.2;
+  const CarState a = car_derivative(c, s, with), b = car_derivative(c, s, without);
+  const double speed = std::hypot(4.0, 1.2);
+  CHECK(a[kVx] - b[kVx] == Approx(-0.6 * speed * 4.0 / c.mass_kg).epsilon(1e-12));
+  CHECK(a[kVy] - b[kVy] == Approx(-0.6 * speed * 1.2 / c.mass_kg).epsilon(1e-12));
+
+  // Coasting straight: the wheels spin down with the car, so the inertia is m + (I_f + I_r) / R^2.
+  const double v0 = 8.0, drag = 0.6;
+  const double m_eff = c.mass_kg + (c.front_wheel_inertia_kgm2 + c.rear_wheel_inertia_kgm2) / (c.wheel_radius_m * c.wheel_radius_m);
+  CarState x = rolling(v0, c);
+  for (int i = 0; i < 5000; ++i) x = rk4_step(c, x, with, 0.001);
+  CHECK(x[kVx] == Approx(v0 / (1 + drag * v0 * 5.0 / m_eff)).epsilon(0.01));
+  // Halving and doubling the speed scale the deceleration by 4: the v^2 law.
+  const double d1 = car_derivative(c, rolling(3.0, c), with)[kVx], d2 = car_derivative(c, rolling(6.0, c), with)[kVx];
+  CHECK(d2 / d1 == Approx(4.0).epsilon(1e-9));
+}
+
+TEST_CASE("evidence: a grade adds -g sin(theta) along the slope and nothing across it", "[evidence]") {
+  const CarConstants c = frictionless_straight();
+  const double grade = 0.08, theta = std::atan(grade);
+  double ax = 0, ay = 0;
+  ground_gravity_body(grade, 0.0, 0.0, 9.81, &ax, &ay);  // heading uphill along +x
+  CHECK(ax == Approx(-9.81 * std::sin(theta)).epsilon(1e-12));
+  CHECK(ay == Approx(0.0).margin(1e-15));
+  ground_gravity_body(0.0, grade, 0.0, 9.81, &ax, &ay);  // the slope rises to the car's left
+  CHECK(ax == Approx(0.0).margin(1e-15));
+  CHECK(ay == Approx(-9.81 * std::sin(theta)).epsilon(1e-12));
+  ground_gravity_body(grade, 0.0, M_PI, 9.81, &ax, &ay);  // downhill
+  CHECK(ax == Approx(9.81 * std::sin(theta)).epsilon(1e-12));
+
+  CarInputs flat, hill;
+  ground_gravity_body(grade, 0.0, 0.0, c.gravity_mps2, &hill.gravity_x_mps2, &hill.gravity_y_mps2);
+  const CarState s = rolling(5.0, c);
+  CHECK(car_derivative(c, s, hill)[kVx] - car_derivative(c, s, flat)[kVx] ==
+        Approx(-c.gravity_mps2 * std::sin(theta)).epsilon(1e-12));
+  // Rolling up a constant grade the car (with its wheels) decelerates at m g sin(theta) / m_eff.
+  const double m_eff = c.mass_kg + (c.front_wheel_inertia_kgm2 + c.rear_wheel_inertia_kgm2) / (c.wheel_radius_m * c.wheel_radius_m);
+  // (after the first second: the tyres need a little slip before they slow the wheels)
+  CarState x = rolling(6.0, c);
+  for (int i = 0; i < 1000; ++i) x = rk4_step(c, x, hill, 0.001);
+  const double v1 = x[kVx];
+  for (int i = 0; i < 1000; ++i) x = rk4_step(c, x, hill, 0.001);
+  CHECK(v1 - x[kVx] == Approx(c.mass_kg * c.gravity_mps2 * std::sin(theta) / m_eff).epsilon(0.01));
+}
+
+TEST_CASE("evidence: the battery's motor torque solves its own voltage equation", "[evidence]") {
+  const CarConstants c;
+  Battery b;
+  b.internal_resistance_fraction = 0.3;
+  b.capacity_sag = 0.2;
+  b.charge_used = 30;  // open circuit 1 - 0.2 * 30 / 60 = 0.9
+  const double u = 0.6, rim = 6.0;
+  const double t = b.torque_Nm(c, u, rim);
+  // T = stall (u V - rim / v0) with V = 0.9 - 0.3 T / stall (per unit of the nominal voltage).
+  const double v = 0.9 - 0.3 * t / c.stall_torque_Nm;
+  CHECK(t == Approx(c.stall_torque_Nm * (u * v - rim / c.no_load_speed_mps)).epsilon(1e-12));
+  CHECK(t < c.stall_torque_Nm * (u - rim / c.no_load_speed_mps));  // less than a fresh battery gives
+  Battery fresh;
+  CHECK(fresh.torque_Nm(c, u, rim) == Approx(c.stall_torque_Nm * (u - rim / c.no_load_speed_mps)));
+  b.draw(c, 5.0, 2.0);
+  CHECK(b.charge_used == Approx(30 + 0.5 * 2.0));
+}
+
+TEST_CASE("evidence: recordings are reproducible by seed and differ between seeds", "[evidence]") {
+  const std::string dir = (std::filesystem::temp_directory_path() / "mppi_evidence_test").string();
+  std::filesystem::remove_all(dir);
+  EvidenceOptions o;
+  o.duration_s = 12;
+  o.truth_names = set_truth_effects("steer_delay_s=0.05,grip_patch_scale=0.6", &o.truth);
+  o.seed = 4;
+  const EvidenceResult a = generate_evidence(o, dir + "/a.csv");
+  const EvidenceResult b = generate_evidence(o, dir + "/b.csv");
+  o.seed = 5;
+  const EvidenceResult c = generate_evidence(o, dir + "/c.csv");
+  auto body = [](const std::string& p) {
+    const std::string s = slurp(p);
+    return s.substr(s.find("\nt,"));
+  };
+  CHECK(body(a.csv) == body(b.csv));
+  CHECK(body(a.clean_csv) == body(b.clean_csv));
+  CHECK(body(a.csv) != body(c.csv));
+  const sim::Recording rec = sim::RecordingReader::read(a.csv), clean = sim::RecordingReader::read(a.clean_csv);
+  CHECK(rec.rows() == clean.rows());
+  CHECK(rec.rows() > 500);
+  const std::string truth = slurp(a.truth_json);
+  CHECK(truth.find("\"steer_delay\"") != std::string::npos);
+  CHECK(truth.find("out of library") != std::string::npos);  // the grip patches
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("evidence: the generator's sources include nothing of the diagnosis or the effect table", "[evidence]") {
+  const std::filesystem::path folder = std::filesystem::path(test::data_path("..")) / "sysid" / "evidence";
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    const std::string text = slurp(entry.path().string());
+    ++files;
+    INFO(entry.path().string());
+    CHECK(text.find("#include \"dynamics/") == std::string::npos);
+    CHECK(text.find("sysid/diagnose") == std::string::npos);
+    CHECK(text.find("with_effects") == std::string::npos);
+    CHECK(text.find("corrected_model") == std::string::npos);
+  }
+  CHECK(files >= 8);
+}
