@@ -256,7 +256,7 @@ EvidenceResult generate_evidence(const EvidenceOptions& o, const std::string& cs
     e["table_ids"] = info.table_ids;
     e["in_library"] = !info.table_ids.empty();
     if (info.table_ids.empty())
-      e["expected_answer"] = "out of library: no place-dependent candidate; a correct diagnosis names nothing reliable or says suspected";
+      e["expected_answer"] = "out of library: a correct diagnosis names nothing reliable or says suspected";
     effects.push_back(e);
   }
   j["effects"] = effects;

@@ -69,7 +69,7 @@ const std::vector<TruthEffectInfo>& truth_effect_catalogue() {
        "payload_mass_scale=1.25,payload_yaw_inertia_scale=1.4"},
       {"hill", {"grade"}, {"road_grade"}, "tilted ground plane dz/dx = grade (gravity g sin theta along it)",
        "grade=0.02", "grade=0.06"},
-      {"grip_patches", {"grip_patch_scale"}, {}, "discs of lower grip on the track (surface map)",
+      {"grip_patches", {"grip_patch_scale"}, {"grip_patch"}, "discs of lower grip on the track (surface map)",
        "grip_patch_scale=0.8", "grip_patch_scale=0.5"},
       {"gyro_bias", {"gyro_bias_radps"}, {"gyro_bias"}, "the gyro reads r + b", "gyro_bias_radps=0.02",
        "gyro_bias_radps=0.08"},
