@@ -12,6 +12,7 @@ commands:
   convert    convert a shipped real-data recording into the project's recording format
   diagnose   compare a recording against the simulator's prediction (sim vs real)
   protocol   simulate the paper's estimation manoeuvres on the full-vehicle plant
+  calibrate  fit a plant's drivetrain, brakes, steering and tyres to a learned dynamics model
 )";
 
 }  // namespace
@@ -26,6 +27,7 @@ int main(int argc, char** argv) {
   if (std::strcmp(cmd, "convert") == 0) return mppi_fit_convert(argc - 1, argv + 1);
   if (std::strcmp(cmd, "diagnose") == 0) return mppi_fit_diagnose(argc - 1, argv + 1);
   if (std::strcmp(cmd, "protocol") == 0) return mppi_fit_protocol(argc - 1, argv + 1);
+  if (std::strcmp(cmd, "calibrate") == 0) return mppi_fit_calibrate(argc - 1, argv + 1);
   std::fprintf(stderr, "mppi-fit: unknown command '%s'\n%s", cmd, kUsage);
   return 2;
 }

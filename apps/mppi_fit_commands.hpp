@@ -6,3 +6,4 @@ int mppi_fit_estimate(int argc, char** argv);  // apps/mppi_fit_estimate.cpp
 int mppi_fit_convert(int argc, char** argv);   // apps/mppi_fit_convert.cpp
 int mppi_fit_diagnose(int argc, char** argv);  // apps/mppi_fit_diagnose.cpp
 int mppi_fit_protocol(int argc, char** argv);  // apps/mppi_fit_protocol.cpp
+int mppi_fit_calibrate(int argc, char** argv); // apps/mppi_fit_calibrate.cpp

@@ -64,9 +64,9 @@ std::vector<std::string> split_lines(const std::string& s) {
   return lines;
 }
 
-std::string speed_label(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f m/s", v);
+std::string speed_label(double v, const std::string& unit) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.1f %s", v, unit.c_str());
   return buf;
 }
 
@@ -186,9 +186,9 @@ void plot_track_run(const std::string& png_path, const Track& track,
     }
     cv::rectangle(img, {x0, y0}, {x0 + bar_w, y1}, kTextColour, 1);
     const int font = cv::FONT_HERSHEY_SIMPLEX;
-    cv::putText(img, "speed", {x0 - 8, y0 - 10}, font, 0.5, kTextColour, 1, cv::LINE_AA);
-    cv::putText(img, speed_label(v_max), {x0 + bar_w + 6, y0 + 5}, font, 0.45, kTextColour, 1, cv::LINE_AA);
-    cv::putText(img, speed_label(v_min), {x0 + bar_w + 6, y1 + 5}, font, 0.45, kTextColour, 1, cv::LINE_AA);
+    cv::putText(img, options.quantity, {x0 - 8, y0 - 10}, font, 0.5, kTextColour, 1, cv::LINE_AA);
+    cv::putText(img, speed_label(v_max, options.unit), {x0 + bar_w + 6, y0 + 5}, font, 0.45, kTextColour, 1, cv::LINE_AA);
+    cv::putText(img, speed_label(v_min, options.unit), {x0 + bar_w + 6, y1 + 5}, font, 0.45, kTextColour, 1, cv::LINE_AA);
   }
   // Title.
   for (std::size_t i = 0; i < title_lines.size(); ++i)

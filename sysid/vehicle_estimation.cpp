@@ -33,6 +33,7 @@ double* single_track_field(SingleTrackParams& p, const std::string& n) {
       {"max_steer_rad", &SingleTrackParams::max_steer_rad},
       {"stall_torque_Nm", &SingleTrackParams::stall_torque_Nm},
       {"no_load_speed_mps", &SingleTrackParams::no_load_speed_mps},
+      {"brake_torque_ratio", &SingleTrackParams::brake_torque_ratio},
       {"rolling_resistance", &SingleTrackParams::rolling_resistance},
       {"aero_drag_kgpm", &SingleTrackParams::aero_drag_kgpm}};
   static const std::map<std::string, double PacejkaParams::*> t = {
@@ -110,7 +111,7 @@ double value_or(const sim::Recording& rec, const char* col, std::size_t row, dou
 std::vector<std::string> single_track_param_names() {
   return {"mass_kg", "yaw_inertia_kgm2", "cg_to_front_axle_m", "cg_to_rear_axle_m", "cg_height_m",
           "wheel_radius_m", "front_wheel_inertia_kgm2", "rear_wheel_inertia_kgm2", "max_steer_rad",
-          "stall_torque_Nm", "no_load_speed_mps", "rolling_resistance", "aero_drag_kgpm",
+          "stall_torque_Nm", "no_load_speed_mps", "brake_torque_ratio", "rolling_resistance", "aero_drag_kgpm",
           "tyre.B", "tyre.C", "tyre.D", "tyre.E", "tyre.Sh", "tyre.Sv"};
 }
 
