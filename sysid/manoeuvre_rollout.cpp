@@ -29,9 +29,9 @@ Piece draw_piece(int manoeuvre, std::mt19937_64& rng) {
   p.side = u01(rng) < 0.5 ? -1.0 : 1.0;
   switch (manoeuvre) {
     case 1: p.target_mps = in(4, 6); p.amplitude = in(0.2, 0.45); p.period_s = in(2.5, 6); break;
-    case 2: p.target_mps = in(4, 6); p.amplitude = in(0.5, 0.9); p.period_s = in(1.2, 2.5); break;
+    case 2: p.target_mps = in(4, 6); p.amplitude = in(0.3, 0.6); p.period_s = in(1.5, 3); break;
     case 3: p.target_mps = in(7, 10); p.brake = in(-0.99, -0.3); break;
-    case 4: p.target_mps = in(6, 8); p.amplitude = in(0.7, 1.0); break;
+    case 4: p.target_mps = in(6, 8); p.amplitude = in(0.45, 0.8); break;
     default: p.target_mps = in(8, 10); p.amplitude = in(0.08, 0.2); p.period_s = in(3, 7); break;
   }
   return p;
@@ -104,12 +104,12 @@ sim::Recording roll_out_manoeuvres(const RolloutStep& step, std::vector<double> 
         if (tin < 0.3 * o.piece_duration_s) {
           throttle = hold(piece.target_mps);
           steer = 0.1 * piece.side;
-        } else if (tin < 0.65 * o.piece_duration_s) {
+        } else if (tin < 0.55 * o.piece_duration_s) {
           throttle = o.max_throttle;
           steer = piece.side * piece.amplitude;
-        } else if (tin < 0.85 * o.piece_duration_s) {
+        } else if (tin < 0.7 * o.piece_duration_s) {
           throttle = 0.3;
-          steer = -0.5 * piece.side;
+          steer = -0.4 * piece.side;
         } else {
           throttle = hold(5.0);
           steer = -0.3 * r;
@@ -119,6 +119,13 @@ sim::Recording roll_out_manoeuvres(const RolloutStep& step, std::vector<double> 
         throttle = hold(piece.target_mps);
         steer = piece.side * piece.amplitude * std::sin(kTwoPi * tin / piece.period_s);
         break;
+    }
+    // Recovery, as a driver catches a spin: countersteer on the yaw rate and hold a moderate
+    // speed while the car is outside the regime of the data (spinning, sliding far, too slow).
+    if (std::abs(r) > o.recover_yaw_rate_radps || std::abs(x[state::kVy]) > o.recover_lateral_mps ||
+        vx < o.recover_below_mps) {
+      steer = std::clamp(-0.3 * r, -0.6, 0.6);
+      throttle = hold(5.0);
     }
     steer_noise = a * steer_noise + b * 0.08 * gauss(rng);
     throttle_noise = a * throttle_noise + b * 0.05 * gauss(rng);

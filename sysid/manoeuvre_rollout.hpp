@@ -29,6 +29,11 @@ struct ManoeuvreOptions {
   double ff_per_mps = 0.018;
   double speed_gain_per_mps = 0.15;  // proportional speed feedback [throttle per m/s]
   double initial_speed_mps = 5.0;
+  // The driver recovers (countersteers, holds 5 m/s) whenever |yaw rate|, |v_y| or v_x leave
+  // these bounds, so the sequences stay where the paper's data were taken.
+  double recover_yaw_rate_radps = 2.5;
+  double recover_lateral_mps = 2.0;
+  double recover_below_mps = 3.5;
   // Column names for the model's states after the common 7 (x[7], x[8], ...), recorded too
   // when given (e.g. "omega_front", "omega_rear" for the single-track's wheel speeds).
   std::vector<std::string> extra_state_columns;
