@@ -51,6 +51,8 @@ def svg(runs, path):
     for i, (label, key) in enumerate(panels):
         ox = pad + i * (w + pad)
         vals = [r[key] for r in runs if not math.isnan(r[key])] or [0.0]
+        if key == "mean":
+            vals += targets  # the reference line (mean = target) stays inside the panel
         y0, y1 = min(0.0, min(vals)), max(vals) * 1.1 or 1.0
         sx = lambda x: ox + (x - x0) / (x1 - x0) * w
         sy = lambda y: pad + h - (y - y0) / (y1 - y0) * h
