@@ -25,3 +25,4 @@ void add_estimate_command(CLI::App& fit, FitCommands& commands);  // apps/mppi_f
 void add_convert_command(CLI::App& fit, FitCommands& commands);   // apps/mppi_fit_convert.cpp
 void add_diagnose_command(CLI::App& fit, FitCommands& commands);  // apps/mppi_fit_diagnose.cpp
 void add_protocol_command(CLI::App& fit, FitCommands& commands);  // apps/mppi_fit_protocol.cpp
+void add_calibrate_command(CLI::App& fit, FitCommands& commands);  // apps/mppi_fit_calibrate.cpp

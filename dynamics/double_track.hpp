@@ -50,7 +50,7 @@ struct FourWheelCoeffs {
   T inv_wheel_inertia[4];               // 1 / (I_f / 2) front, 1 / (I_r / 2) rear
   T static_load[4];                     // f_iz^0 [N]
   T load_per_fx[4], load_per_fy[4];     // a_i, b_i [N/N]
-  T max_steer, stall_torque, inv_no_load_speed, rolling_force, inv_rolling_speed, drag;
+  T max_steer, stall_torque, brake_ratio, inv_no_load_speed, rolling_force, inv_rolling_speed, drag;
   T slip_floor, inv_slip_blend;
   PacejkaCoeffs<T> tyre;
 
@@ -81,6 +81,7 @@ struct FourWheelCoeffs {
     }
     k.max_steer = t(p.max_steer_rad);
     k.stall_torque = t(p.stall_torque_Nm);
+    k.brake_ratio = t(p.brake_torque_ratio);
     k.inv_no_load_speed = t(1 / p.no_load_speed_mps);
     k.rolling_force = t(p.rolling_resistance * mg);
     k.inv_rolling_speed = t(1 / p.rolling_resistance_speed_mps);
@@ -160,7 +161,8 @@ template <class T>
   e->body_fx_N = body_fx;
   e->body_fy_N = body_fy;
   const T omega_rear = T(0.5) * (omega[wheel::kLR] + omega[wheel::kRR]);  // differential carrier
-  e->drive_torque_Nm = k.stall_torque * (throttle - omega_rear * k.radius * k.inv_no_load_speed);
+  e->drive_torque_Nm = k.stall_torque * (std::max(throttle, T(0)) + k.brake_ratio * std::min(throttle, T(0)) -
+                                         omega_rear * k.radius * k.inv_no_load_speed);
   e->resist_force_N =
       -k.rolling_force * phys::tanh(vx * k.inv_rolling_speed) - k.drag * vx * std::abs(vx);
   e->dvx_mps2 = (body_fx + e->resist_force_N) * k.inv_mass + vy * r;
@@ -306,6 +308,7 @@ class DoubleTrack {
     }
     f.max_steer = t(d.max_steer);
     f.stall_torque = t(d.stall_torque);
+    f.brake_ratio = t(d.brake_ratio);
     f.inv_no_load_speed = t(d.inv_no_load_speed);
     f.rolling_force = t(d.rolling_force);
     f.inv_rolling_speed = t(d.inv_rolling_speed);

@@ -8,6 +8,7 @@
 //   dVy = (fFx sin d + fFy cos d + fRy) / m - Vx r
 //   dr  = ((fFy cos d + fFx sin d) l_f - fRy l_r) / I_z
 //   I_f domega_f = -fFx R,   I_r domega_r = T_rear - fRx R
+// T_rear = T_stall (max(u, 0) + k_brake min(u, 0) - omega_r R / v_no_load) (vehicle_params.hpp).
 // Tyre-frame velocities: front (Vx cos d + (Vy + r l_f) sin d, -Vx sin d + (Vy + r l_f) cos d),
 // rear (Vx, Vy - r l_r); friction from dynamics/pacejka.hpp; normal loads from Velenis'
 // quasi-static pitch transfer
@@ -35,7 +36,7 @@ template <class T>
 struct SingleTrackCoeffs {
   T inv_mass, inv_yaw_inertia, lf, lr, h, radius, inv_front_inertia, inv_rear_inertia;
   T weight;  // m g [N]
-  T max_steer, stall_torque, inv_no_load_speed, rolling_force, inv_rolling_speed, drag;
+  T max_steer, stall_torque, brake_ratio, inv_no_load_speed, rolling_force, inv_rolling_speed, drag;
   T slip_floor, inv_slip_blend;
   PacejkaCoeffs<T> tyre;
 
@@ -44,7 +45,7 @@ struct SingleTrackCoeffs {
     return {t(1 / p.mass_kg), t(1 / p.yaw_inertia_kgm2), t(p.cg_to_front_axle_m),
             t(p.cg_to_rear_axle_m), t(p.cg_height_m), t(p.wheel_radius_m),
             t(1 / p.front_wheel_inertia_kgm2), t(1 / p.rear_wheel_inertia_kgm2),
-            t(p.mass_kg * p.gravity_mps2), t(p.max_steer_rad), t(p.stall_torque_Nm),
+            t(p.mass_kg * p.gravity_mps2), t(p.max_steer_rad), t(p.stall_torque_Nm), t(p.brake_torque_ratio),
             t(1 / p.no_load_speed_mps), t(p.rolling_resistance * p.mass_kg * p.gravity_mps2),
             t(1 / p.rolling_resistance_speed_mps), t(p.aero_drag_kgpm), t(p.slip_speed_floor_mps),
             t(1 / p.slip_blend), PacejkaCoeffs<T>::from(p.tyre)};
@@ -93,7 +94,8 @@ inline void single_track_terms(const SingleTrackCoeffs<T>& k, T vx, T vy, T r, T
   e->front_fy_N = e->front.mu_y * e->front_fz_N;
   e->rear_fx_N = e->rear.mu_x * e->rear_fz_N;
   e->rear_fy_N = e->rear.mu_y * e->rear_fz_N;
-  e->drive_torque_Nm = k.stall_torque * (throttle - omega_r * k.radius * k.inv_no_load_speed);
+  e->drive_torque_Nm = k.stall_torque * (std::max(throttle, T(0)) + k.brake_ratio * std::min(throttle, T(0)) -
+                                         omega_r * k.radius * k.inv_no_load_speed);
   e->resist_force_N = -k.rolling_force * phys::tanh(vx * k.inv_rolling_speed) - k.drag * vx * std::abs(vx);
   const T body_fx = e->front_fx_N * cd - e->front_fy_N * sd + e->rear_fx_N;  // body x
   const T body_fy = e->front_fx_N * sd + e->front_fy_N * cd + e->rear_fy_N;  // body y

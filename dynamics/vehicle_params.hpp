@@ -33,6 +33,10 @@ struct SingleTrackParams {
   // With the resistances below: steady 5.3 m/s at throttle 0.3, 13.1 at 0.65, 19.6 at 1.
   double stall_torque_Nm = 10.0;          // rear axle torque at throttle 1, wheel still [N m]
   double no_load_speed_mps = 30.0;        // rim speed where throttle 1 gives zero torque [m/s]
+  // Negative throttle (brake) scaled separately: the torque line is
+  //   T_rear = stall_torque * (max(throttle, 0) + brake_torque_ratio * min(throttle, 0) - omega_r R / no_load_speed);
+  // 1 = the same line for both signs.
+  double brake_torque_ratio = 1.0;        // brake torque at throttle -1 / stall torque [-]
   double rolling_resistance = 0.05;       // c_rr [-]: force c_rr m g tanh(vx / v_rr) (loose dirt)
   double rolling_resistance_speed_mps = 0.5;  // v_rr [m/s]: smooths the sign at standstill
   double aero_drag_kgpm = 0.05;           // c_d [N s^2/m^2]: force c_d vx |vx| (~0.5 rho Cd A)
@@ -187,6 +191,8 @@ inline std::vector<ParamField> param_table(SingleTrackParams& p, bool with_aero_
       param("max_steer_rad", &p.max_steer_rad, "rad", open(0, 1.5), "front wheel angle at steer = +-1"),
       param("stall_torque_Nm", &p.stall_torque_Nm, "N m", non_negative(), "rear axle torque at throttle 1, wheel still"),
       param("no_load_speed_mps", &p.no_load_speed_mps, "m/s", positive(), "rim speed where throttle 1 gives no torque"),
+      param("brake_torque_ratio", &p.brake_torque_ratio, "-", non_negative(),
+            "torque at throttle -1 (brake) relative to the stall torque"),
       param("rolling_resistance", &p.rolling_resistance, "-", non_negative(), "rolling resistance c_rr (force c_rr m g)"),
       param("rolling_resistance_speed_mps", &p.rolling_resistance_speed_mps, "m/s", positive(),
             "speed v_rr smoothing the resistance's sign at standstill"),
@@ -194,7 +200,7 @@ inline std::vector<ParamField> param_table(SingleTrackParams& p, bool with_aero_
       param("slip_speed_floor_mps", &p.slip_speed_floor_mps, "m/s", positive(), "slip denominator floor v_floor"),
       param("slip_blend", &p.slip_blend, "-", positive(), "slip blend eps: force x tanh(s / eps)"),
   };
-  if (!with_aero_drag) f.erase(f.begin() + 14);  // aero_drag_kgpm
+  if (!with_aero_drag) f.erase(f.begin() + 15);  // aero_drag_kgpm
   for (const ParamField& t : param_table(p.tyre)) f.push_back(t);
   return f;
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <numbers>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -160,7 +161,8 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
     log = std::make_unique<RecordingWriter>(
         config.out_dir + "/log.csv",
         std::vector<std::string>{"roll", "applied_steer", "applied_throttle", "progress_m",
-                                 "lap", "optimizer_ms", "effective_sample_size", "min_cost"},
+                                 "lap", "optimizer_ms", "effective_sample_size", "min_cost",
+                                 "slip_angle_rad", "lateral_accel_mps2"},
         std::vector<std::pair<std::string, std::string>>{
             {"source", "mppi-sim"}, {"track", track.name()}, {"model", config.model},
             {"plant", config.plant}, {"seed", std::to_string(config.controller.seed)},
@@ -180,6 +182,9 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   std::vector<float> model_x(static_cast<std::size_t>(setup.model_states));
   std::vector<double> optimizer_ms, ess;
   std::vector<PathSample> path;
+  std::vector<PathSample> slip_path;  // the same trail, value = |body slip| [deg]
+  std::vector<double> abs_slip;
+  double prev_vy = 0.0, prev_t = -1.0;
   std::vector<std::pair<float, float>> crash_points;
   double speed_sum = 0.0;
   long speed_samples = 0;
@@ -253,11 +258,22 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
     ++speed_samples;
     summary.max_speed_mps = std::max(summary.max_speed_mps, speed);
     path.push_back({s.x_m, s.y_m, static_cast<float>(speed)});
+    const double slip = std::atan2(static_cast<double>(s.vy_mps), static_cast<double>(s.vx_mps));
+    const double lat_accel = (prev_t >= 0.0 && t > prev_t ? (s.vy_mps - prev_vy) / (t - prev_t) : 0.0) +
+                             static_cast<double>(s.vx_mps) * s.yaw_rate_radps;
+    prev_vy = s.vy_mps;
+    prev_t = t;
+    if (s.vx_mps > 1.0f) {
+      abs_slip.push_back(std::abs(slip));
+      summary.peak_slip_angle_rad = std::max(summary.peak_slip_angle_rad, std::abs(slip));
+      summary.peak_lateral_accel_mps2 = std::max(summary.peak_lateral_accel_mps2, std::abs(lat_accel));
+    }
+    slip_path.push_back({s.x_m, s.y_m, static_cast<float>(s.vx_mps > 1.0f ? std::abs(slip) * 180.0 / std::numbers::pi : 0.0)});
     if (log) {
       const double extras[] = {s.roll_rad, plant.applied().steer, plant.applied().throttle,
                                laps.progress_m(), static_cast<double>(laps.laps_completed()),
                                step_summary.optimizer_ms, step_summary.effective_sample_size,
-                               step_summary.min_cost};
+                               step_summary.min_cost, slip, lat_accel};
       log->write(t, s, command, extras);
     }
     if (config.observer)
@@ -283,6 +299,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   summary.finished = summary.laps_completed >= config.laps;
   summary.mean_speed_mps = speed_samples ? speed_sum / speed_samples : 0.0;
   summary.optimizer_ms_p50 = percentile(optimizer_ms, 50);
+  summary.p95_slip_angle_rad = abs_slip.empty() ? 0.0 : percentile(abs_slip, 95);
   summary.optimizer_ms_p99 = percentile(optimizer_ms, 99);
   double ess_sum = 0;
   for (double e : ess) ess_sum += e;
@@ -295,6 +312,10 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
                   summary.laps_completed, format_times(summary.lap_times_s).c_str(),
                   summary.crashes);
     plot_track_run(config.out_dir + "/track.png", track, path, crash_points, title);
+    PlotOptions slip_plot;
+    slip_plot.quantity = "body slip";
+    slip_plot.unit = "deg";
+    plot_track_run(config.out_dir + "/track_slip.png", track, slip_path, crash_points, title, slip_plot);
     write_summary(config.out_dir + "/summary.json", summary);
   }
   return summary;

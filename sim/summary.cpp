@@ -35,6 +35,9 @@ std::string to_json(const RunSummary& s) {
   j["crash_reasons"] = s.crash_reasons;
   j["mean_speed_mps"] = number(s.mean_speed_mps);
   j["max_speed_mps"] = number(s.max_speed_mps);
+  j["peak_slip_angle_rad"] = number(s.peak_slip_angle_rad);
+  j["p95_slip_angle_rad"] = number(s.p95_slip_angle_rad);
+  j["peak_lateral_accel_mps2"] = number(s.peak_lateral_accel_mps2);
   j["optimizer_ms_p50"] = number(s.optimizer_ms_p50);
   j["optimizer_ms_p99"] = number(s.optimizer_ms_p99);
   j["effective_sample_size_mean"] = number(s.effective_sample_size_mean);

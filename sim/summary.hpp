@@ -22,6 +22,11 @@ struct RunSummary {
   std::vector<std::string> crash_reasons;
   double mean_speed_mps = 0.0;
   double max_speed_mps = 0.0;
+  // Body slip angle atan2(v_y, v_x) and lateral acceleration dv_y/dt + v_x r, at the control
+  // rate; peaks over samples with v_x > 1 m/s (slip is undefined near standstill).
+  double peak_slip_angle_rad = 0.0;   // max |slip|
+  double p95_slip_angle_rad = 0.0;    // 95th percentile of |slip|
+  double peak_lateral_accel_mps2 = 0.0;
   double optimizer_ms_p50 = 0.0;      // wall time of one controller step, median
   double optimizer_ms_p99 = 0.0;
   double effective_sample_size_mean = 0.0;

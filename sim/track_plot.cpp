@@ -89,7 +89,7 @@ plot::Figure track_run_figure(const Track& track, const std::vector<PathSample>&
   }
   if (has_path) {
     plot::ColourTrail trail;
-    trail.value_label = "speed [m/s]";
+    trail.value_label = options.quantity + " [" + options.unit + "]";
     for (const PathSample& p : path) {
       trail.x.push_back(p.x_m);
       trail.y.push_back(p.y_m);

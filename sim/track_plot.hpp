@@ -24,6 +24,10 @@ struct PlotOptions {
   int width_px = 1000;             // image width; the height follows the track's aspect ratio
   double speed_min_mps = 0.0;      // colour scale; min == max (default) = the path's range
   double speed_max_mps = 0.0;
+  // What the trail's colour shows (PathSample::speed_mps holds its value): colour-bar title
+  // and unit, e.g. "body slip" and "deg" for a slip-angle plot.
+  std::string quantity = "speed";
+  std::string unit = "m/s";
 };
 
 // Speed colour of the plot for speed v on the scale [v_min, v_max] (clamped), as RGB.

@@ -33,8 +33,11 @@ double* single_track_field(SingleTrackParams& p, const std::string& n) {
       {"max_steer_rad", &SingleTrackParams::max_steer_rad},
       {"stall_torque_Nm", &SingleTrackParams::stall_torque_Nm},
       {"no_load_speed_mps", &SingleTrackParams::no_load_speed_mps},
+      {"brake_torque_ratio", &SingleTrackParams::brake_torque_ratio},
       {"rolling_resistance", &SingleTrackParams::rolling_resistance},
-      {"aero_drag_kgpm", &SingleTrackParams::aero_drag_kgpm}};
+      {"aero_drag_kgpm", &SingleTrackParams::aero_drag_kgpm},
+      {"slip_speed_floor_mps", &SingleTrackParams::slip_speed_floor_mps},
+      {"slip_blend", &SingleTrackParams::slip_blend}};
   static const std::map<std::string, double PacejkaParams::*> t = {
       {"tyre.B", &PacejkaParams::B}, {"tyre.C", &PacejkaParams::C}, {"tyre.D", &PacejkaParams::D},
       {"tyre.E", &PacejkaParams::E}, {"tyre.Sh", &PacejkaParams::Sh}, {"tyre.Sv", &PacejkaParams::Sv}};
@@ -110,8 +113,8 @@ double value_or(const sim::Recording& rec, const char* col, std::size_t row, dou
 std::vector<std::string> single_track_param_names() {
   return {"mass_kg", "yaw_inertia_kgm2", "cg_to_front_axle_m", "cg_to_rear_axle_m", "cg_height_m",
           "wheel_radius_m", "front_wheel_inertia_kgm2", "rear_wheel_inertia_kgm2", "max_steer_rad",
-          "stall_torque_Nm", "no_load_speed_mps", "rolling_resistance", "aero_drag_kgpm",
-          "tyre.B", "tyre.C", "tyre.D", "tyre.E", "tyre.Sh", "tyre.Sv"};
+          "stall_torque_Nm", "no_load_speed_mps", "brake_torque_ratio", "rolling_resistance", "aero_drag_kgpm",
+          "tyre.B", "tyre.C", "tyre.D", "tyre.E", "tyre.Sh", "tyre.Sv", "slip_speed_floor_mps", "slip_blend"};
 }
 
 std::vector<std::string> full_vehicle_param_names() {

@@ -54,6 +54,7 @@ struct SingleTrackModel {
             MPPI_COEFF("K_WEIGHT", weight),
             MPPI_COEFF("K_MAX_STEER", max_steer),
             MPPI_COEFF("K_STALL", stall_torque),
+            MPPI_COEFF("K_BRAKE_RATIO", brake_ratio),
             MPPI_COEFF("K_INV_NO_LOAD", inv_no_load_speed),
             MPPI_COEFF("K_ROLLING", rolling_force),
             MPPI_COEFF("K_INV_ROLLING_SPEED", inv_rolling_speed),

@@ -407,8 +407,9 @@ TEST_CASE("SingleTrack rejects invalid parameters and initialises rolling wheels
 
 TEST_CASE("Vehicle parameter YAML: the shipped file, strict keys, errors with file and line",
           "[physics][params]") {
-  // The shipped file restates the defaults (so the two cannot drift apart silently).
-  const auto path = mppi::test::data_path("config/autorally_single_track.yaml");
+  // The shipped uncalibrated variant restates the defaults (so the two cannot drift apart
+  // silently); the default file holds the calibrated values (tests/sysid/test_calibration.cpp).
+  const auto path = mppi::test::data_path("config/autorally_single_track_uncalibrated.yaml");
   const SingleTrackParams loaded = mppi::load_single_track_params(path);
   const SingleTrackParams d;
   CHECK(loaded.mass_kg == d.mass_kg);
@@ -429,6 +430,7 @@ TEST_CASE("Vehicle parameter YAML: the shipped file, strict keys, errors with fi
   CHECK(loaded.max_steer_rad == d.max_steer_rad);
   CHECK(loaded.stall_torque_Nm == d.stall_torque_Nm);
   CHECK(loaded.no_load_speed_mps == d.no_load_speed_mps);
+  CHECK(loaded.brake_torque_ratio == d.brake_torque_ratio);
   CHECK(loaded.rolling_resistance == d.rolling_resistance);
   CHECK(loaded.rolling_resistance_speed_mps == d.rolling_resistance_speed_mps);
   CHECK(loaded.aero_drag_kgpm == d.aero_drag_kgpm);

@@ -1,6 +1,8 @@
 // Short closed-loop runs in the simulator: MPPI must lap the Gazebo oval without touching a
 // barrier, near the target speed, and a run must be reproducible from its seed.
 #include <catch2/catch.hpp>
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -52,6 +54,27 @@ TEST_CASE("the AutoRally network drives the physics plant around the oval", "[si
   std::ifstream json(out + "/summary.json");
   std::string text((std::istreambuf_iterator<char>(json)), {});
   CHECK(text.find("\"laps_completed\": 1") != std::string::npos);
+  CHECK(std::filesystem::file_size(out + "/track_slip.png") > 10000);
+  // Body slip and lateral acceleration in the log, recomputed from the logged velocities:
+  // slip = atan2(vy, vx); a_y = dvy/dt + vx r (backward difference over the control step).
+  const auto& t = log.column("t");
+  const auto& vx = log.column("vx");
+  const auto& vy = log.column("vy");
+  const auto& r = log.column("yaw_rate");
+  const auto& slip = log.column("slip_angle_rad");
+  const auto& ay = log.column("lateral_accel_mps2");
+  double peak_slip = 0, peak_ay = 0;
+  for (std::size_t i = 1; i < log.rows(); ++i) {
+    CHECK(slip[i] == Approx(std::atan2(vy[i], vx[i])).margin(1e-5));
+    CHECK(ay[i] == Approx((vy[i] - vy[i - 1]) / (t[i] - t[i - 1]) + vx[i] * r[i]).margin(1e-3));
+    if (vx[i] > 1.0) {
+      peak_slip = std::max(peak_slip, std::abs(slip[i]));
+      peak_ay = std::max(peak_ay, std::abs(ay[i]));
+    }
+  }
+  CHECK(summary.peak_slip_angle_rad == Approx(peak_slip).margin(1e-5));
+  CHECK(summary.peak_lateral_accel_mps2 == Approx(peak_ay).margin(1e-3));
+  CHECK(summary.p95_slip_angle_rad <= summary.peak_slip_angle_rad);
 }
 
 TEST_CASE("a closed-loop run is reproducible from its seed", "[sim][closed_loop]") {

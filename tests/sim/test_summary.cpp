@@ -53,8 +53,11 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.optimizer_ms_p50 = 1.5;
   s.optimizer_ms_p99 = std::numeric_limits<double>::quiet_NaN();
   s.effective_sample_size_mean = 42.5;
+  s.peak_slip_angle_rad = 0.25;
+  s.p95_slip_angle_rad = 0.125;
+  s.peak_lateral_accel_mps2 = 6.5;
   const auto j = nlohmann::json::parse(to_json(s));
-  CHECK(j.size() == 18);
+  CHECK(j.size() == 21);
   CHECK(j.at("track") == "gazebo");
   CHECK(j.at("model") == "nn_autorally");
   CHECK(j.at("plant") == "single_track");
@@ -73,6 +76,9 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   CHECK(j.at("optimizer_ms_p50") == 1.5);
   CHECK(j.at("optimizer_ms_p99").is_null());
   CHECK(j.at("effective_sample_size_mean") == 42.5);
+  CHECK(j.at("peak_slip_angle_rad") == 0.25);
+  CHECK(j.at("p95_slip_angle_rad") == 0.125);
+  CHECK(j.at("peak_lateral_accel_mps2") == 6.5);
 
   const std::string path = (std::filesystem::temp_directory_path() /
                             ("mppi_sim_test_summary_" + std::to_string(::getpid()) + ".json")).string();

@@ -40,7 +40,7 @@ void model_step(inout float x[NX], float steer, float throttle, float dt) {
   precise float rear_fz = K_WEIGHT - front_fz;
   precise float ffx = fmu.x * front_fz, ffy = fmu.y * front_fz;
   precise float rfx = rmu.x * rear_fz, rfy = rmu.y * rear_fz;
-  precise float drive = K_STALL * (throttle - omega_r * K_RADIUS * K_INV_NO_LOAD);
+  precise float drive = K_STALL * (maxf(throttle, 0.0) + K_BRAKE_RATIO * minf(throttle, 0.0) - omega_r * K_RADIUS * K_INV_NO_LOAD);
   precise float resist = -K_ROLLING * fast_tanh(vx * K_INV_ROLLING_SPEED) - K_DRAG * vx * abs(vx);
   precise float body_fx = ffx * cd - ffy * sd + rfx;
   precise float body_fy = ffx * sd + ffy * cd + rfy;

@@ -1,0 +1,289 @@
+#include "sysid/calibration.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Dense>
+
+#include "mppi/error.hpp"
+
+namespace mppi::sysid {
+
+namespace {
+
+constexpr double kDivergedResidual = 10.0;  // normalised residual of a non-finite prediction
+
+// Where the rollouts start and which model state each channel is.
+struct RolloutPlan {
+  std::vector<std::size_t> starts;
+  int steps = 0;                    // samples predicted per rollout (leads 1..steps)
+  std::vector<int> state_index;     // per channel
+  std::vector<const std::vector<double>*> measured;
+  const std::vector<double>* t = nullptr;
+  const std::vector<double>* steer = nullptr;
+  const std::vector<double>* throttle = nullptr;
+};
+
+RolloutPlan make_plan(const VehicleModelSpec& spec, const sim::Recording& rec, const PredictionErrorOptions& o) {
+  std::string why;
+  if (!o.is_valid(&why)) throw Error("prediction error: " + why);
+  RolloutPlan p;
+  p.t = &rec.column("t");
+  p.steer = &rec.column("steer");
+  p.throttle = &rec.column("throttle");
+  for (const auto& c : o.channels) {
+    auto it = std::find_if(spec.measurable.begin(), spec.measurable.end(),
+                           [&](const auto& m) { return m.first == c; });
+    if (it == spec.measurable.end())
+      throw Error("prediction error: the " + spec.kind + " model does not predict channel '" + c + "'");
+    p.state_index.push_back(it->second);
+    p.measured.push_back(&rec.column(c));
+  }
+  const std::size_t n = rec.rows();
+  if (n < 3) throw Error("prediction error: the recording has fewer than 3 rows");
+  const double dt = ((*p.t)[n - 1] - (*p.t)[0]) / static_cast<double>(n - 1);
+  p.steps = std::max(1, static_cast<int>(std::lround(o.horizon_s / dt)));
+  const std::size_t stride = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(o.stride_s / dt)));
+  for (std::size_t s = 0; s + static_cast<std::size_t>(p.steps) < n; s += stride) p.starts.push_back(s);
+  if (p.starts.empty()) throw Error("prediction error: the recording is shorter than one horizon");
+  return p;
+}
+
+// Normalised residuals, [rollout][lead 1..steps][channel] flattened; NaN where not recorded.
+void residuals(const VehicleModelSpec& spec, const std::vector<double>& values, const sim::Recording& rec,
+               const RolloutPlan& p, const std::vector<double>& scales, std::vector<double>& out) {
+  const std::size_t nc = p.state_index.size();
+  out.assign(p.starts.size() * static_cast<std::size_t>(p.steps) * nc, 0.0);
+  std::vector<double> x(static_cast<std::size_t>(spec.nx));
+  std::size_t k = 0;
+  for (std::size_t s : p.starts) {
+    spec.init_state(rec, s, x.data());
+    bool diverged = false;
+    for (int lead = 1; lead <= p.steps; ++lead) {
+      const std::size_t i = s + static_cast<std::size_t>(lead);
+      if (!diverged) {
+        const double u[2] = {(*p.steer)[i - 1], (*p.throttle)[i - 1]};
+        spec.step(values, x.data(), u, (*p.t)[i] - (*p.t)[i - 1]);
+        for (double v : x) diverged = diverged || !std::isfinite(v);
+      }
+      for (std::size_t c = 0; c < nc; ++c, ++k) {
+        const double m = (*p.measured[c])[i];
+        out[k] = diverged ? kDivergedResidual : (x[static_cast<std::size_t>(p.state_index[c])] - m) / scales[c];
+      }
+    }
+  }
+}
+
+double mean_square(const std::vector<double>& r) {
+  double s = 0;
+  std::size_t n = 0;
+  for (double v : r)
+    if (std::isfinite(v)) {
+      s += v * v;
+      ++n;
+    }
+  return n ? s / static_cast<double>(n) : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+bool PredictionErrorOptions::is_valid(std::string* why) const {
+  auto fail = [&](const char* m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (!(horizon_s > 0 && std::isfinite(horizon_s))) return fail("horizon_s must be > 0");
+  if (!(stride_s > 0 && std::isfinite(stride_s))) return fail("stride_s must be > 0");
+  if (channels.empty()) return fail("at least one channel is needed");
+  for (double h : report_horizons_s)
+    if (!(h > 0 && h <= horizon_s + 1e-9)) return fail("report horizons must be in (0, horizon_s]");
+  return true;
+}
+
+bool CalibrationOptions::is_valid(std::string* why) const {
+  if (!error.is_valid(why)) return false;
+  if (max_iterations < 0 || !(relative_tolerance >= 0) || !(log_range > 1)) {
+    if (why) *why = "max_iterations >= 0, relative_tolerance >= 0 and log_range > 1 are required";
+    return false;
+  }
+  return true;
+}
+
+std::vector<double> channel_scales(const sim::Recording& rec, const std::vector<std::string>& channels) {
+  std::vector<double> out;
+  for (const auto& c : channels) {
+    double s = 0, s2 = 0;
+    std::size_t n = 0;
+    for (double v : rec.column(c))
+      if (std::isfinite(v)) {
+        s += v;
+        s2 += v * v;
+        ++n;
+      }
+    const double mean = n ? s / static_cast<double>(n) : 0;
+    const double var = n ? s2 / static_cast<double>(n) - mean * mean : 0;
+    if (!(var > 1e-12)) throw Error("channel scales: column '" + c + "' is constant or empty");
+    out.push_back(std::sqrt(var));
+  }
+  return out;
+}
+
+PredictionError prediction_error(const VehicleModelSpec& spec, const std::vector<double>& values,
+                                 const sim::Recording& rec, const std::vector<double>& scales,
+                                 const PredictionErrorOptions& o) {
+  const RolloutPlan p = make_plan(spec, rec, o);
+  const std::size_t nc = p.state_index.size();
+  if (scales.size() != nc) throw Error("prediction error: one scale per channel is needed");
+  std::vector<double> r;
+  residuals(spec, values, rec, p, scales, r);
+  PredictionError e;
+  e.channels = o.channels;
+  e.scales = scales;
+  e.horizons_s = o.report_horizons_s;
+  e.rollouts = static_cast<int>(p.starts.size());
+  const double dt = (*p.t)[1] - (*p.t)[0];
+  std::vector<int> lead_of;
+  for (double h : o.report_horizons_s) lead_of.push_back(std::clamp(static_cast<int>(std::lround(h / dt)), 1, p.steps));
+  e.nrmse_at.assign(nc, std::vector<double>(lead_of.size(), 0.0));
+  e.nrmse.assign(nc, 0.0);
+  for (std::size_t c = 0; c < nc; ++c) {
+    std::vector<double> sum_at(lead_of.size(), 0.0);
+    std::vector<std::size_t> n_at(lead_of.size(), 0);
+    double sum = 0;
+    std::size_t n = 0;
+    for (std::size_t w = 0; w < p.starts.size(); ++w)
+      for (int lead = 1; lead <= p.steps; ++lead) {
+        const double v = r[(w * static_cast<std::size_t>(p.steps) + static_cast<std::size_t>(lead - 1)) * nc + c];
+        if (!std::isfinite(v)) continue;
+        sum += v * v;
+        ++n;
+        for (std::size_t h = 0; h < lead_of.size(); ++h)
+          if (lead == lead_of[h]) {
+            sum_at[h] += v * v;
+            ++n_at[h];
+          }
+      }
+    e.nrmse[c] = n ? std::sqrt(sum / static_cast<double>(n)) : std::numeric_limits<double>::quiet_NaN();
+    for (std::size_t h = 0; h < lead_of.size(); ++h)
+      e.nrmse_at[c][h] = n_at[h] ? std::sqrt(sum_at[h] / static_cast<double>(n_at[h]))
+                                 : std::numeric_limits<double>::quiet_NaN();
+    e.mean_nrmse += e.nrmse[c] / static_cast<double>(nc);
+  }
+  return e;
+}
+
+CalibrationResult calibrate(const VehicleModelSpec& spec, const sim::Recording& rec, const std::vector<double>& scales,
+                            const CalibrationOptions& o, std::vector<double> initial) {
+  std::string why;
+  if (!o.is_valid(&why)) throw Error("calibrate: " + why);
+  const std::size_t np = spec.estimated.size();
+  if (initial.empty()) initial = spec.nominal;
+  if (initial.size() != np) throw Error("calibrate: one initial value per estimated parameter is needed");
+  if (!o.bounds.empty() && o.bounds.size() != np) throw Error("calibrate: one bound pair per parameter is needed");
+  const RolloutPlan plan = make_plan(spec, rec, o.error);
+  if (scales.size() != plan.state_index.size()) throw Error("calibrate: one scale per channel is needed");
+
+  // Search space: z = log(p) for positive parameters, z = p otherwise; box in z.
+  std::vector<double> lo(np), hi(np);
+  for (std::size_t i = 0; i < np; ++i) {
+    const std::string& n = spec.estimated[i];
+    if (!o.bounds.empty()) {
+      lo[i] = o.bounds[i].first;
+      hi[i] = o.bounds[i].second;
+    } else if (spec.log_scale[i]) {
+      lo[i] = spec.nominal[i] / o.log_range;
+      hi[i] = spec.nominal[i] * o.log_range;
+    } else if (n == "tyre.C") {
+      lo[i] = 0.05, hi[i] = 1.99;
+    } else if (n == "tyre.E") {
+      lo[i] = -10, hi[i] = 0.99;
+    } else {
+      lo[i] = -std::numeric_limits<double>::infinity(), hi[i] = std::numeric_limits<double>::infinity();
+    }
+    if (spec.log_scale[i]) {
+      if (!(lo[i] > 0)) throw Error("calibrate: the lower bound of " + n + " must be > 0");
+      lo[i] = std::log(lo[i]);
+      hi[i] = std::log(hi[i]);
+    }
+  }
+  auto to_values = [&](const Eigen::VectorXd& z) {
+    std::vector<double> v(np);
+    for (std::size_t i = 0; i < np; ++i) v[i] = spec.log_scale[i] ? std::exp(z[static_cast<Eigen::Index>(i)]) : z[static_cast<Eigen::Index>(i)];
+    return v;
+  };
+  auto project = [&](Eigen::VectorXd& z) {
+    for (std::size_t i = 0; i < np; ++i) z[static_cast<Eigen::Index>(i)] = std::clamp(z[static_cast<Eigen::Index>(i)], lo[i], hi[i]);
+  };
+  Eigen::VectorXd z(static_cast<Eigen::Index>(np));
+  for (std::size_t i = 0; i < np; ++i) {
+    if (spec.log_scale[i] && !(initial[i] > 0)) throw Error("calibrate: " + spec.estimated[i] + " must start > 0");
+    z[static_cast<Eigen::Index>(i)] = spec.log_scale[i] ? std::log(initial[i]) : initial[i];
+  }
+  project(z);
+
+  CalibrationResult res;
+  res.names = spec.estimated;
+  res.initial = initial;
+  std::vector<double> r, r2;
+  // Residuals that were not recorded (NaN) do not count: zero them for the least squares.
+  auto eval = [&](const Eigen::VectorXd& zz, std::vector<double>& out) {
+    residuals(spec, to_values(zz), rec, plan, scales, out);
+    ++res.evaluations;
+    const double c = mean_square(out);
+    for (double& v : out)
+      if (!std::isfinite(v)) v = 0;
+    return c;
+  };
+  double cost = eval(z, r);
+  res.cost_history.push_back(cost);
+  const Eigen::Index m = static_cast<Eigen::Index>(r.size());
+  Eigen::MatrixXd J(m, static_cast<Eigen::Index>(np));
+  double lambda = 1e-3;
+  for (int it = 0; it < o.max_iterations; ++it) {
+    for (std::size_t j = 0; j < np; ++j) {
+      const Eigen::Index jj = static_cast<Eigen::Index>(j);
+      Eigen::VectorXd zp = z;
+      double h = 1e-4 * std::max(1.0, std::abs(z[jj]));
+      if (zp[jj] + h > hi[j]) h = -h;  // stay inside the box
+      zp[jj] += h;
+      eval(zp, r2);
+      for (Eigen::Index k = 0; k < m; ++k) J(k, jj) = (r2[static_cast<std::size_t>(k)] - r[static_cast<std::size_t>(k)]) / h;
+    }
+    const Eigen::Map<const Eigen::VectorXd> rv(r.data(), m);
+    const Eigen::MatrixXd JtJ = J.transpose() * J;
+    const Eigen::VectorXd g = J.transpose() * rv;
+    bool improved = false;
+    for (int tries = 0; tries < 12 && !improved; ++tries) {
+      Eigen::MatrixXd A = JtJ;
+      for (Eigen::Index d = 0; d < A.rows(); ++d) A(d, d) += lambda * std::max(JtJ(d, d), 1e-12);
+      Eigen::VectorXd zn = z - A.ldlt().solve(g);
+      project(zn);
+      const double cn = eval(zn, r2);
+      if (std::isfinite(cn) && cn < cost) {
+        const double rel = (cost - cn) / cost;
+        z = zn;
+        r.swap(r2);
+        cost = cn;
+        lambda = std::max(lambda / 3, 1e-9);
+        improved = true;
+        res.cost_history.push_back(cost);
+        if (rel < o.relative_tolerance) it = o.max_iterations;  // converged
+      } else {
+        lambda *= 10;
+      }
+    }
+    res.iterations = it + 1;
+    if (!improved) break;
+  }
+  res.values = to_values(z);
+  res.at_bound.resize(np);
+  for (std::size_t i = 0; i < np; ++i) {
+    const double zi = z[static_cast<Eigen::Index>(i)];
+    res.at_bound[i] = std::abs(zi - lo[i]) < 1e-9 || std::abs(zi - hi[i]) < 1e-9;
+  }
+  res.iterations = std::min(res.iterations, o.max_iterations);
+  return res;
+}
+
+}  // namespace mppi::sysid

@@ -1,0 +1,76 @@
+#pragma once
+// Calibrating a physics model to recordings by its multi-step open-loop prediction error:
+// every `stride_s` a rollout of `horizon_s` starts from the recorded state and is driven by
+// the recorded commands; the residuals are the predicted minus recorded channels (body
+// velocities and yaw rate by default), each divided by the channel's standard deviation in
+// the recording (normalised RMSE). The fit is Levenberg-Marquardt with a forward-difference
+// Jacobian over the parameters a VehicleModelSpec exposes (positive ones in log space), kept
+// inside a box. docs/CALIBRATION.md.
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "sim/recording.hpp"
+#include "sysid/vehicle_estimation.hpp"
+
+namespace mppi::sysid {
+
+struct PredictionErrorOptions {
+  double horizon_s = 1.0;   // rollout length
+  double stride_s = 0.5;    // a rollout starts every stride_s
+  std::vector<std::string> channels = {"vx", "vy", "yaw_rate"};
+  std::vector<double> report_horizons_s = {0.1, 0.25, 0.5, 1.0};  // error tabulated at these
+
+  bool is_valid(std::string* why) const;
+};
+
+struct PredictionError {
+  std::vector<std::string> channels;
+  std::vector<double> scales;                  // channel standard deviation (normaliser)
+  std::vector<double> horizons_s;              // = options.report_horizons_s
+  std::vector<std::vector<double>> nrmse_at;   // [channel][horizon]: RMSE at that lead / scale
+  std::vector<double> nrmse;                   // [channel]: RMSE over every lead in (0, horizon] / scale
+  double mean_nrmse = 0;                       // mean of nrmse over the channels (the headline)
+  int rollouts = 0;
+};
+
+// Standard deviation of each column over the recording (finite values); throws mppi::Error
+// for a missing column or one that is constant.
+std::vector<double> channel_scales(const sim::Recording& rec, const std::vector<std::string>& channels);
+
+// Prediction error of the model with `values` on `rec`, normalised by `scales` (one per
+// channel). Throws mppi::Error for a channel the model does not measure, invalid options, or
+// a recording shorter than one horizon. A rollout that goes non-finite counts with residual
+// 10 (normalised) from then on.
+PredictionError prediction_error(const VehicleModelSpec& spec, const std::vector<double>& values,
+                                 const sim::Recording& rec, const std::vector<double>& scales,
+                                 const PredictionErrorOptions& options = {});
+
+struct CalibrationOptions {
+  PredictionErrorOptions error;
+  int max_iterations = 40;
+  double relative_tolerance = 1e-5;  // stop when the cost falls less than this (relative)
+  // Box, per parameter: positive (log-scale) ones within [nominal / range, nominal x range];
+  // tyre.C in [0.05, 1.99], tyre.E in [-10, 0.99], other linear ones unbounded.
+  double log_range = 20.0;
+  std::vector<std::pair<double, double>> bounds;  // overrides (physical units), one per parameter
+
+  bool is_valid(std::string* why) const;
+};
+
+struct CalibrationResult {
+  std::vector<std::string> names;
+  std::vector<double> initial, values;       // physical units
+  std::vector<double> cost_history;          // mean squared normalised residual per iteration
+  std::vector<bool> at_bound;                // value ended on its box edge
+  int iterations = 0;
+  int evaluations = 0;
+};
+
+// Fits spec's estimated parameters, starting from `initial` (default: spec.nominal), to
+// minimise the mean squared normalised prediction residual on `rec` with `scales`.
+CalibrationResult calibrate(const VehicleModelSpec& spec, const sim::Recording& rec,
+                            const std::vector<double>& scales, const CalibrationOptions& options = {},
+                            std::vector<double> initial = {});
+
+}  // namespace mppi::sysid
