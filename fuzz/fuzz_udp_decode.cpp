@@ -12,8 +12,9 @@ namespace udp = mppi::chassis::udp;
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 2) return 0;
   const bool fix_crc = (data[0] & 1) != 0;
-  // The second byte: how much longer the datagram was on the wire than what was received.
-  const std::size_t truncated_by = data[1] % 8;
+  // The second byte: from 0xF0 on, the datagram was 1-16 bytes longer on the wire than what
+  // was received (a truncating receive buffer).
+  const std::size_t truncated_by = data[1] >= 0xF0 ? data[1] - 0xEFu : 0u;
   std::vector<std::uint8_t> bytes(data + 2, data + size);
   if (fix_crc && bytes.size() >= 4) {
     const std::uint32_t crc = udp::crc32(std::span(bytes.data(), bytes.size() - 4));
