@@ -1,11 +1,14 @@
 // Inputs that once escaped the parsers' own error reporting (found by the fuzz targets in
 // fuzz/): each must now give an mppi::Error that names the source and the place.
 #include <catch2/catch.hpp>
+#include <sstream>
 #include <string>
 
 #include "chassis/calibration.hpp"
 #include "chassis/priorities.hpp"
 #include "dynamics/corrected_model.hpp"
+#include "sim/recording.hpp"
+#include "sysid/diagnose/data.hpp"
 #include "error_of.hpp"
 
 using mppi::test::error_of;
@@ -46,4 +49,13 @@ TEST_CASE("corrected-model files: keys and names that are not text are named wit
                    corrected_model_from_yaml("nominal: autorally-nn\nnominal_params: {network_npz: [x]}\n", "m.yaml");
                  }),
                  "m.yaml (nominal_params):2:31: network_npz must be a plain text value"));
+}
+
+TEST_CASE("diagnosis preparation of a one-row recording is refused, whatever minimum is asked",
+          "[malformed][diagnose]") {
+  std::istringstream in("t,x,y,yaw,vx,vy,yaw_rate,steer,throttle\n0,0,0,0,1,0,0,0,0.2\n");
+  const mppi::sim::Recording rec = mppi::sim::RecordingReader::read(in, "one_row.csv");
+  for (std::size_t min_rows : {0, 1, 2})
+    CHECK(contains(error_of([&] { mppi::diagnose::prepare(rec, "one_row.csv", min_rows); }),
+                   "one_row.csv: too short for diagnosis: 1 rows, need at least 2"));
 }
