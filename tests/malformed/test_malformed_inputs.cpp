@@ -42,7 +42,7 @@ TEST_CASE("corrected-model files: keys and names that are not text are named wit
   CHECK(contains(error_of([] { corrected_model_from_yaml("model: {a: 1}\n", "m.yaml"); }),
                  "m.yaml:1:8: model must be a plain text value"));
   CHECK(contains(error_of([] { corrected_model_from_yaml("model: corrected\nnominal:\n", "m.yaml"); }),
-                 "m.yaml: nominal must be a plain text value"));
+                 "m.yaml:3:1: nominal must be a plain text value"));
   CHECK(contains(error_of([] { corrected_model_from_yaml("selected: [a, [b]]\n", "m.yaml"); }),
                  "m.yaml:1:15: an entry of selected must be a plain text value"));
   CHECK(contains(error_of([] {
