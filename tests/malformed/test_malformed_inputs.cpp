@@ -1,5 +1,6 @@
-// Inputs that once escaped the parsers' own error reporting (found by the fuzz targets in
-// fuzz/): each must now give an mppi::Error that names the source and the place.
+// Inputs that once escaped the parsers' own error reporting (a yaml-cpp conversion exception,
+// an out-of-range read), of the kind the fuzz targets in fuzz/ generate: each must now give an
+// mppi::Error that names the source and the place.
 #include <catch2/catch.hpp>
 #include <sstream>
 #include <string>
