@@ -99,7 +99,7 @@ ActuatorCalibration parse_actuator(const YAML::Node& node, const std::string& na
   ActuatorCalibration a;
   bool has[4] = {};
   for (const auto& kv : node) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = detail::text(kv.first, "a key of actuator '" + name + "'", source);
     if (key == "min") a.min_us = number(kv.second, key, source), has[0] = true;
     else if (key == "center") a.center_us = number(kv.second, key, source), has[1] = true;
     else if (key == "max") a.max_us = number(kv.second, key, source), has[2] = true;
@@ -124,10 +124,10 @@ Calibration Calibration::parse_yaml(const std::string& text, const std::string& 
   if (!root.IsMap()) throw Error(source + ": a chassis calibration must be a YAML map");
   std::map<std::string, ActuatorCalibration> found;
   for (const auto& kv : root) {
-    std::string name = kv.first.as<std::string>();
+    std::string name = detail::text(kv.first, "an actuator name", source);
     bool indexed = false;
     if (kv.second.IsMap() && kv.second["name"]) {  // '0': {name: 'steering', ...}
-      name = kv.second["name"].as<std::string>();
+      name = detail::text(kv.second["name"], "an actuator name", source);
       indexed = true;
     }
     if (name != "steering" && name != "throttle" && name != "frontBrake")

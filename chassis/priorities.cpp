@@ -41,7 +41,7 @@ Priorities Priorities::parse_yaml(const std::string& text, const std::string& so
   std::vector<PriorityEntry> entries;
   std::set<int> numbers;
   for (const auto& kv : root) {
-    const std::string name = kv.first.as<std::string>();
+    const std::string name = detail::text(kv.first, "a controller name", source);
     const long p = integer(kv.second, name, source);
     if (p < 0 || p > 1000000)
       throw Error(where(source, kv.second) + ": priority of '" + name + "' must be in [0, 1e6]");

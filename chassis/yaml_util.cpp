@@ -45,6 +45,11 @@ double number(const YAML::Node& node, const std::string& key, const std::string&
   return v;
 }
 
+std::string text(const YAML::Node& node, const std::string& what, const std::string& source) {
+  if (!node.IsScalar()) throw Error(where(source, node) + ": " + what + " must be a plain text value");
+  return node.Scalar();
+}
+
 long integer(const YAML::Node& node, const std::string& key, const std::string& source) {
   if (!node.IsScalar()) throw Error(where(source, node) + ": '" + key + "' must be an integer");
   const std::string s = node.Scalar();

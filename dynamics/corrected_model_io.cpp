@@ -26,13 +26,13 @@ CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std:
   std::string nominal_text;  // parsed once the nominal model is known (keys in any order)
   YAML::Node nominal_node;
   for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = yaml_text(kv.first, "a key", source);
     const YAML::Node& v = kv.second;
     if (key == "model") {
-      if (v.as<std::string>() != "corrected")
+      if (yaml_text(v, "model", source) != "corrected")
         throw Error(yaml_where(source, v.Mark()) + ": model must be 'corrected'");
     } else if (key == "nominal") {
-      out.nominal_model = v.as<std::string>();
+      out.nominal_model = yaml_text(v, "nominal", source);
       if (!is_corrected_nominal_model(out.nominal_model))
         throw Error(yaml_where(source, v.Mark()) + ": nominal must be one of " + kCorrectedNominalModels + ", got '" +
                     out.nominal_model + "'");
@@ -46,7 +46,7 @@ CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std:
       read_param_yaml(param_table(out.effects), v, source, "effects");
     } else if (key == "selected") {
       if (!v.IsSequence()) throw Error(yaml_where(source, v.Mark()) + ": selected must be a list");
-      for (const auto& s : v) out.selected.push_back(s.as<std::string>());
+      for (const auto& s : v) out.selected.push_back(yaml_text(s, "an entry of selected", source));
     } else {
       throw Error(yaml_where(source, kv.first.Mark()) + ": unknown key '" + key +
                   "' (valid: model, nominal, nominal_params, effects, selected)");
@@ -65,9 +65,9 @@ CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std:
     if (!nominal_text.empty()) {
       if (!nominal_node.IsMap()) throw Error(where + ": expected a map with network_npz");
       for (const auto& kv : nominal_node) {
-        const std::string k = kv.first.as<std::string>();
+        const std::string k = yaml_text(kv.first, "a key", where);
         if (k != "network_npz") throw Error(yaml_where(where, kv.first.Mark()) + ": unknown key '" + k + "' (valid: network_npz)");
-        out.network_npz = kv.second.IsNull() ? "" : kv.second.as<std::string>();
+        out.network_npz = kv.second.IsNull() ? "" : yaml_text(kv.second, "network_npz", where);
       }
     }
   } else if (!nominal_text.empty()) {

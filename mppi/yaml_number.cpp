@@ -28,4 +28,9 @@ double yaml_number(const YAML::Node& value, const std::string& key, const std::s
   return v;
 }
 
+std::string yaml_text(const YAML::Node& value, const std::string& what, const std::string& source) {
+  if (!value.IsScalar()) throw Error(yaml_where(source, value.Mark()) + ": " + what + " must be a plain text value");
+  return value.Scalar();
+}
+
 }  // namespace mppi

@@ -18,4 +18,8 @@ std::string yaml_where(const std::string& source, const YAML::Mark& mark);
 double yaml_number(const YAML::Node& value, const std::string& key, const std::string& source,
                    bool allow_infinite = false);
 
+// The scalar `value` as text (a key or a name). Throws mppi::Error with file:line:column if it
+// is a map, a list or null; `what` names it in the message ("key", "nominal").
+std::string yaml_text(const YAML::Node& value, const std::string& what, const std::string& source);
+
 }  // namespace mppi

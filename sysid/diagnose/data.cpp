@@ -28,6 +28,7 @@ DiagData prepare(const sim::Recording& rec, const std::string& source, std::size
                     (src->second == "mppi-sim" || src->second.rfind("mppi-fit synth", 0) == 0))
                        ? 1 : 0;
   const std::size_t n = d.t.size();
+  min_rows = std::max<std::size_t>(min_rows, 2);  // the sample interval needs two rows
   if (n < min_rows)
     throw Error(source + ": too short for diagnosis: " + std::to_string(n) + " rows, need at least " +
                 std::to_string(min_rows));

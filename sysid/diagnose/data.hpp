@@ -35,7 +35,7 @@ struct DiagData {
   }
 };
 
-// Throws mppi::Error naming the file for missing columns, fewer than `min_rows` usable rows.
+// Throws mppi::Error naming the file for missing columns, fewer than `min_rows` (at least 2) usable rows.
 DiagData prepare(const sim::Recording& rec, const std::string& source, std::size_t min_rows = 250);
 
 // Reads and prepares a recording file (sim::RecordingReader, then prepare()).

@@ -25,7 +25,7 @@ TEST_CASE("fast_sincos, fast_atan and fast_sqrt against libm", "[physics][math]"
     atan_err = std::max(atan_err, std::abs(mppi::fast_atan(x) - std::atan(double(x))));
   }
   for (int i = 1; i < 200000; ++i) {
-    const float x = i * i * 1e-6f;  // (0, 4e4]
+    const float x = float(double(i) * i * 1e-6);  // (0, 4e4]
     sqrt_rel_err = std::max(sqrt_rel_err, std::abs(mppi::fast_sqrt(x) / std::sqrt(double(x)) - 1));
   }
   CHECK(sc_err < 1e-6);

@@ -1,0 +1,17 @@
+// Recording CSV reader (sim/recording.cpp) and the diagnosis preparation of what it read
+// (sysid/diagnose/data.cpp: columns, pieces, sample interval).
+#include <sstream>
+
+#include "fuzz/fuzz_input.hpp"
+#include "sim/recording.hpp"
+#include "sysid/diagnose/data.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  mppi::fuzz::expect_value_or_error([&] {
+    std::istringstream in(mppi::fuzz::as_text(data, size));
+    const mppi::sim::Recording rec = mppi::sim::RecordingReader::read(in, "fuzz.csv");
+    // Any minimum row count, down to 0, must be safe.
+    mppi::diagnose::prepare(rec, "fuzz.csv", /*min_rows=*/size % 4);
+  });
+  return 0;
+}

@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# The test suite under sanitizers (GCC, -O1), each in a build folder of its own:
+#   build-asan  AddressSanitizer + UndefinedBehaviorSanitizer (+ LeakSanitizer): mppi-tests,
+#               every test case except those tagged [slow] (see below)
+#   build-tsan  ThreadSanitizer: mppi-thread-tests, the threaded parts (tests/CMakeLists.txt)
+# Any report stops the program with a non-zero exit (-fno-sanitize-recover=all, halt_on_error),
+# so the run fails. Only the test programs and the libraries they link are built (no
+# benchmarks, no command-line programs, no Python module).
+#
+# Usage: scripts/sanitize.sh [asan|tsan|all]   (default all)
+#
+# Left out, and why:
+# - ASan: nothing but test cases tagged [slow] (long closed loops whose code the shorter cases
+#   already run; they would take most of the CI time budget at the sanitizers' 3-10x cost).
+#   The Python tests (python.pytest) and the package test run only in the normal build.
+# - TSan: the OpenMP schedules (ThreadSchedule::kDynamic / kStatic). Debian's libgomp is not
+#   built with -fsanitize=thread, so TSan does not see its barriers and reports races that are
+#   not there; the default schedule, oneTBB work stealing, is what runs under TSan. Python
+#   threads releasing the GIL are not run under TSan either: CPython is not instrumented.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+which="${1:-all}"
+jobs=$(nproc 2>/dev/null || echo 2)
+
+sanitizer_build() {  # <dir> <target> <flags>
+  local dir=$1 target=$2 flags=$3
+  local t0=$SECONDS
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Sanitize \
+    -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g1 -fno-omit-frame-pointer $flags" \
+    -DCMAKE_EXE_LINKER_FLAGS_SANITIZE="$flags" -DCMAKE_SHARED_LINKER_FLAGS_SANITIZE="$flags" \
+    -DMPPI_BUILD_TESTS=ON -DMPPI_BUILD_BENCH=OFF -DMPPI_BUILD_APPS=OFF "${@:4}" >/dev/null
+  cmake --build "$dir" -j"$jobs" --target "$target"
+  echo "[sanitize] $dir: $target built in $((SECONDS - t0)) s"
+}
+
+# Runs mppi-tests in two processes (one per core), split by tags.
+run_asan() {
+  export ASAN_OPTIONS="detect_leaks=1:halt_on_error=1:detect_stack_use_after_return=0:strict_string_checks=1"
+  export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+  local t0=$SECONDS bin=build-asan/bin/mppi-tests
+  local first="[sysid],[diagnose]"
+  "$bin" "~[slow]$first" >build-asan/part1.log 2>&1 &
+  local pid1=$!
+  local rc2=0 rc1=0
+  "$bin" "~[slow]~[sysid]~[diagnose]" >build-asan/part2.log 2>&1 || rc2=$?
+  wait "$pid1" || rc1=$?
+  tail -n 3 build-asan/part1.log build-asan/part2.log
+  echo "[sanitize] ASan+UBSan suite ran in $((SECONDS - t0)) s"
+  if [ "$rc1" -ne 0 ] || [ "$rc2" -ne 0 ]; then
+    grep -h -B2 -A30 "ERROR: AddressSanitizer\|runtime error\|ERROR: LeakSanitizer\|FAILED" \
+      build-asan/part1.log build-asan/part2.log | head -n 200
+    echo "[sanitize] ASan+UBSan: FAILED" >&2
+    return 1
+  fi
+}
+
+run_tsan() {
+  export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1"
+  local t0=$SECONDS
+  build-tsan/bin/mppi-thread-tests
+  echo "[sanitize] TSan threaded tests ran in $((SECONDS - t0)) s"
+}
+
+case "$which" in
+  asan|all)
+    sanitizer_build build-asan mppi-tests "-fsanitize=address,undefined -fno-sanitize-recover=all"
+    run_asan ;;&
+  tsan|all)
+    # MPPI_NO_MULTIVERSION: the ifunc resolvers of the target_clones kernels run while the
+    # program is relocated, before the TSan runtime is up; instrumented, they crash at start.
+    sanitizer_build build-tsan mppi-thread-tests "-fsanitize=thread -DMPPI_NO_MULTIVERSION" -DMPPI_VULKAN=OFF
+    run_tsan ;;
+  asan) ;;
+  *) echo "usage: $0 [asan|tsan|all]" >&2; exit 2 ;;
+esac
