@@ -31,6 +31,9 @@ const char* kUsage = R"(usage: mppi-sim [options]
   --backend NAME       auto | cpu | vulkan: auto takes a GPU through Vulkan if
                        there is one, else the CPU; vulkan also takes a CPU Vulkan
                        device (lavapipe); MPPI_VULKAN_DEVICE=<index|name> picks one (auto)
+  --inject-device-loss-at-step N
+                       fault drill: the backend fails like a lost GPU after N control steps;
+                       the run goes on on the CPU backend (summary.json: backend_switches)
   --cost-config FILE   AutoRally cost weights (YAML)
   --plant-params FILE  the plant's data file (YAML parameters, or a corrected-model file)
   --model-params FILE  the controller model's data file (the same kinds)
@@ -103,6 +106,7 @@ int main(int argc, char** argv) {
         usage_error(e.what());
       }
     }
+    else if (flag == "--inject-device-loss-at-step") config.inject_device_loss_at_step = parse_int(flag, value());
     else if (flag == "--cost-config") config.cost_params_yaml = value();
     else if (flag == "--plant-params") config.plant_params_yaml = value();
     else if (flag == "--model-params") config.model_params_yaml = value();

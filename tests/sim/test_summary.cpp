@@ -54,7 +54,7 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.optimizer_ms_p99 = std::numeric_limits<double>::quiet_NaN();
   s.effective_sample_size_mean = 42.5;
   const auto j = nlohmann::json::parse(to_json(s));
-  CHECK(j.size() == 18);
+  CHECK(j.size() == 21);
   CHECK(j.at("track") == "gazebo");
   CHECK(j.at("model") == "nn_autorally");
   CHECK(j.at("plant") == "single_track");
