@@ -163,7 +163,8 @@ PYBIND11_MODULE(mppi, m) {
   py::enum_<mppi::StepStatus>(m, "StepStatus")
       .value("OK", mppi::StepStatus::kOk)
       .value("INVALID_STATE", mppi::StepStatus::kInvalidState)
-      .value("NO_VALID_ROLLOUT", mppi::StepStatus::kNoValidRollout);
+      .value("NO_VALID_ROLLOUT", mppi::StepStatus::kNoValidRollout)
+      .value("BACKEND_ERROR", mppi::StepStatus::kBackendError);
 
   py::class_<mppi::StepSummary>(m, "StepSummary")
       .def_readonly("status", &mppi::StepSummary::status)

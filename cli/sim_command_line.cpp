@@ -50,6 +50,10 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
       ->type_name("FILE");
   app.add_option("--network", c.network_npz, "weights (.npz) of a learned model, when no --*-params file is given")
       ->type_name("FILE");
+  app.add_option("--inject-device-loss-at-step", c.inject_device_loss_at_step,
+                 "fault drill: the backend fails like a lost GPU after N control steps; the run goes on on the "
+                 "CPU backend (summary.json: backend_switches)")
+      ->type_name("N");
   app.add_option("--surface", c.surface_yaml, "grip and elevation by place (YAML, docs/SURFACES.md; single-track plant)")
       ->type_name("FILE");
   add_out_option(app, c.out_dir, "write DIR/log.csv, DIR/track.png, DIR/summary.json");

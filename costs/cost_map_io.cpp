@@ -53,6 +53,13 @@ CostMap CostMap::load_npz(const std::string& path) {
                 std::to_string(width) + " x " + std::to_string(height) + " = " +
                 std::to_string(expected) + " (from xBounds, yBounds, pixelsPerMeter)");
   std::vector<float> values(c0.values.begin(), c0.values.end());
+  // NaN is refused by CostMap itself; an infinite cell (or a double beyond the float range) too,
+  // here: it would make every rollout through it unusable.
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (std::isinf(values[i]))
+      throw Error(path + ": array 'channel0': value " + (values[i] > 0 ? "inf" : "-inf") + " at row " +
+                  std::to_string(i / static_cast<std::size_t>(width)) + ", col " +
+                  std::to_string(i % static_cast<std::size_t>(width)) + " (as float)");
   try {
     return CostMap(x_min, x_max, y_min, y_max, ppm, std::move(values));
   } catch (const Error& e) {

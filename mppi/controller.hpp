@@ -11,17 +11,21 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <exception>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <span>
 #include <string_view>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mppi/backend.hpp"
 #include "mppi/controller_options.hpp"
 #include "mppi/cpu_backend.hpp"
 #include "mppi/error.hpp"
+#include "mppi/fault_injection.hpp"
 #include "mppi/multiversion.hpp"
 #include "mppi/noise.hpp"
 #include "mppi/savitzky_golay.hpp"
@@ -33,11 +37,14 @@ enum class StepStatus {
   kOk = 0,
   kInvalidState,     // the start state had a NaN/inf: safe control returned, plan kept
   kNoValidRollout,   // every sampled cost was NaN/inf: safe control returned
+  kBackendError,     // the backend failed (e.g. a lost GPU device): safe control returned; with
+                     // a fallback backend set, the following steps run on it
 };
 
 struct StepSummary {
   StepStatus status = StepStatus::kOk;
-  const char* reason = "";           // human-readable, static storage
+  const char* reason = "";           // human-readable; valid until the next step() call
+  bool backend_switched = false;     // this step's failure moved the controller to its fallback
   float min_cost = 0.f;              // best sampled total cost (last iteration)
   float mean_cost = 0.f;             // mean of the finite sampled costs (last iteration)
   float effective_sample_size = 0.f; // 1 / sum w^2 (last iteration), in [1, K]
@@ -95,6 +102,13 @@ namespace detail {
 class Controller {
  public:
   // Takes any backend; throws mppi::Error if the options are invalid for it.
+  // A change of backend after a failure: at which step() call, from which backend to which, and
+  // the failure that caused it.
+  struct BackendSwitch {
+    std::uint64_t step_call = 0;  // 0-based count of step() calls (reset() does not restart it)
+    std::string from, to, reason;
+  };
+
   Controller(std::unique_ptr<Backend> backend, ControllerOptions options)
       : backend_(std::move(backend)), options_(std::move(options)) {
     if (!backend_) throw Error("Controller: no backend");
@@ -122,12 +136,15 @@ class Controller {
   }
 
   // One control step from the full model state x0 (num_states floats). Returns the control to
-  // apply now (num_controls floats, valid until the next call). Never returns NaN.
-  std::span<const float> step(std::span<const float> x0, StepSummary* summary = nullptr) {
+  // apply now (num_controls floats, valid until the next call). Never returns NaN and never
+  // throws: a backend failure gives StepStatus::kBackendError, the safe control and the
+  // backend's message as the reason (and the switch to the fallback backend, if one is set).
+  std::span<const float> step(std::span<const float> x0, StepSummary* summary = nullptr) noexcept {
     const auto start = std::chrono::steady_clock::now();
     StepSummary local;
     StepSummary& sum = summary ? *summary : local;
     sum = StepSummary{};
+    ++step_calls_;
     bool finite = x0.size() == static_cast<std::size_t>(nx_);
     for (std::size_t i = 0; finite && i < x0.size(); ++i) finite = std::isfinite(x0[i]);
     if (!finite) {
@@ -137,18 +154,32 @@ class Controller {
       return safe_output(sum, start);
     }
     std::copy(x0.begin(), x0.end(), x0_.begin());
-    for (int it = 0; it < options_.iterations; ++it) {
-      const auto iteration = static_cast<std::uint32_t>(step_index_ * options_.iterations + it);
-      if (backend_->has_iterate()) {
-        if (!device_iteration(iteration, sum)) return safe_output(sum, start);
-      } else {
-        sample(iteration);
-        backend_->rollout(x0_, controls_, costs_);
-        if (!update_nominal(sum)) return safe_output(sum, start);
+    try {
+      for (int it = 0; it < options_.iterations; ++it) {
+        const auto iteration = static_cast<std::uint32_t>(step_index_ * options_.iterations + it);
+        if (backend_->has_iterate()) {
+          if (!device_iteration(iteration, sum)) return safe_output(sum, start);
+        } else {
+          sample(iteration);
+          backend_->rollout(x0_, controls_, costs_);
+          if (!update_nominal(sum)) return safe_output(sum, start);
+        }
+        sum.iterations = it + 1;
       }
-      sum.iterations = it + 1;
+    } catch (const std::exception& e) {
+      return backend_failed(e.what(), sum, start);
+    } catch (...) {
+      return backend_failed("unknown exception", sum, start);
     }
     std::copy_n(nominal_.begin(), nu_, output_.begin());
+    for (int c = 0; c < nu_; ++c) {
+      if (!std::isfinite(output_[c])) {  // not expected: the plan is a clamped mean of finite values
+        sum.status = StepStatus::kNoValidRollout;
+        sum.reason = "the plan held NaN or inf; it was reset";
+        reset_plan();
+        return safe_output(sum, start);
+      }
+    }
     shift_nominal();
     ++step_index_;
     sum.optimizer_ms = elapsed_ms(start);
@@ -160,18 +191,41 @@ class Controller {
   // the cost map. Call between steps, from the thread that steps. False, with the reason in
   // *why, if the key is unknown, the value out of range or the backend cannot change its cost;
   // the cost is then unchanged.
+  // The changes are kept and applied again to a fallback backend when the controller switches.
   bool set_cost_param(std::string_view key, double value, std::string* why = nullptr) {
-    return backend_->set_cost_param(key, value, why);
+    if (!guarded(why, [&] { return backend_->set_cost_param(key, value, why); })) return false;
+    auto same_key = [&](const auto& kv) { return kv.first == key; };
+    const auto it = std::find_if(cost_params_.begin(), cost_params_.end(), same_key);
+    if (it != cost_params_.end()) it->second = value;
+    else cost_params_.emplace_back(std::string(key), value);
+    return true;
   }
   bool set_cost_map(std::shared_ptr<const CostMap> map, std::string* why = nullptr) {
-    return backend_->set_cost_map(std::move(map), why);
+    if (!guarded(why, [&] { return backend_->set_cost_map(map, why); })) return false;
+    cost_map_ = std::move(map);
+    return true;
+  }
+
+  // The backend to use when the current one fails (a lost GPU device): `make` builds it at the
+  // first failure (make_controller() sets the CPU backend for the same model and cost). The
+  // cost changes made so far are applied to it; the plan is kept.
+  void set_fallback_backend(std::function<std::unique_ptr<Backend>()> make) {
+    make_fallback_ = std::move(make);
+  }
+  bool has_fallback_backend() const { return static_cast<bool>(make_fallback_); }
+  // The backend changes so far (at most one: the fallback is used once).
+  const std::vector<BackendSwitch>& backend_switches() const { return switches_; }
+
+  // Fault injection for tests and drills: after `healthy_steps` more steps (counted as backend
+  // calls, one per iteration) the backend fails like a lost device, and stays failed.
+  void inject_device_loss(std::uint64_t healthy_steps) {
+    backend_ = std::make_unique<DeviceLossInjector>(
+        std::move(backend_), healthy_steps * static_cast<std::uint64_t>(options_.iterations));
   }
 
   // Forget the plan: nominal = zero controls clamped to the limits.
   void reset() {
-    for (int t = 0; t < options_.horizon; ++t)
-      for (int c = 0; c < nu_; ++c)
-        nominal_[t * nu_ + c] = std::clamp(0.f, options_.control_min[c], options_.control_max[c]);
+    reset_plan();
     step_index_ = 0;
   }
 
@@ -310,6 +364,58 @@ class Controller {
     // the last step keeps its previous value (the tail of the plan repeats)
   }
 
+  void reset_plan() {
+    for (int t = 0; t < options_.horizon; ++t)
+      for (int c = 0; c < nu_; ++c)
+        nominal_[t * nu_ + c] = std::clamp(0.f, options_.control_min[c], options_.control_max[c]);
+  }
+
+  // Runs a backend call that may throw; an exception becomes false with its message in *why.
+  template <class F>
+  bool guarded(std::string* why, F&& call) {
+    try {
+      return call();
+    } catch (const std::exception& e) {
+      if (why) *why = std::string(backend_->name()) + " backend failed: " + e.what();
+    } catch (...) {
+      if (why) *why = std::string(backend_->name()) + " backend failed: unknown exception";
+    }
+    return false;
+  }
+
+  // A backend call threw: safe control, the message as the reason, and the fallback backend
+  // from the next step on (if one is set and has not been used yet). Never throws: if even the
+  // message cannot be stored, the reason stays a static text.
+  std::span<const float> backend_failed(const char* what, StepSummary& sum,
+                                        std::chrono::steady_clock::time_point start) noexcept {
+    sum.status = StepStatus::kBackendError;
+    sum.reason = "the backend failed";
+    try {
+      failure_reason_ = std::string(backend_->name()) + " backend failed: " + what;
+      sum.reason = failure_reason_.c_str();
+      if (make_fallback_) {
+        auto make = std::move(make_fallback_);
+        make_fallback_ = nullptr;
+        std::unique_ptr<Backend> fallback = make();
+        if (fallback) {
+          std::string why;
+          for (const auto& [key, value] : cost_params_)
+            if (!fallback->set_cost_param(key, value, &why))
+              failure_reason_ += "; the fallback refused cost parameter " + key + ": " + why;
+          if (cost_map_ && !fallback->set_cost_map(cost_map_, &why))
+            failure_reason_ += "; the fallback refused the cost map: " + why;
+          switches_.push_back({step_calls_ - 1, backend_->name(), fallback->name(), failure_reason_});
+          backend_ = std::move(fallback);
+          sum.backend_switched = true;
+          sum.reason = failure_reason_.c_str();
+        }
+      }
+    } catch (...) {
+      // no fallback then; the safe control still goes out
+    }
+    return safe_output(sum, start);
+  }
+
   std::span<const float> safe_output(StepSummary& sum,
                                      std::chrono::steady_clock::time_point start) {
     std::copy(options_.safe_control.begin(), options_.safe_control.end(), output_.begin());
@@ -327,6 +433,12 @@ class Controller {
   int nu_ = 0, nx_ = 0, padded_ = 0, threads_ = 1;
   std::unique_ptr<ParallelRunner> runner_;  // the CPU threads of sampling and the weighted sum
   std::uint64_t step_index_ = 0;
+  std::uint64_t step_calls_ = 0;      // step() calls since construction
+  std::function<std::unique_ptr<Backend>()> make_fallback_;
+  std::vector<BackendSwitch> switches_;
+  std::string failure_reason_;        // StepSummary::reason of the last backend failure
+  std::vector<std::pair<std::string, double>> cost_params_;  // cost changes, latest per key
+  std::shared_ptr<const CostMap> cost_map_;
   std::vector<float> nominal_;        // T x nu
   std::vector<float> next_;           // T x nu, the unsmoothed update
   std::vector<float> controls_;       // T x nu x padded

@@ -1,7 +1,8 @@
 #pragma once
 // make_controller(model, cost, options, choice, &report): a Controller on the backend asked
 // for, falling back to the CPU backend (never failing) when no other backend can run it, and
-// saying which backend runs and why.
+// saying which backend runs and why. A controller on a GPU backend falls back to the CPU
+// backend when the GPU fails while it runs (Controller::set_fallback_backend).
 //   auto   -> a real GPU (discrete first) through a registered GPU backend, else the CPU backend
 //   cpu    -> the CPU backend
 //   vulkan -> any Vulkan device, a CPU one (lavapipe) included, else the CPU backend
@@ -43,7 +44,13 @@ Controller make_controller(D model, C cost, const ControllerOptions& options, Ba
           if (backend) {
             r.backend = factory.name;
             r.reason = factory.describe(*backend, choice);
-            return Controller(std::move(backend), options);
+            Controller controller(std::move(backend), options);
+            // A GPU can fail while running (a lost device): step() then goes on on the CPU.
+            controller.set_fallback_backend([model, cost, options]() -> std::unique_ptr<Backend> {
+              return std::make_unique<CpuBackend<D, C>>(model, cost, options.num_samples, options.horizon,
+                                                        options.dt_s, options.num_threads, options.schedule);
+            });
+            return controller;
           }
         }
       }

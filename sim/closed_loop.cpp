@@ -78,30 +78,40 @@ auto visit_corrected(const std::string& path, const char* flag, F&& f) {
 // The controller and how it reads the plant: full plant state -> controller model state.
 struct ControllerSetup {
   std::unique_ptr<Controller> controller;
+  std::string backend;  // the backend it starts on
   int model_states = 0;
   std::function<void(const float* plant_x, int plant_states, float* model_x)> observe;
   PathPredictor predict;  // the controller model's paths, for an observer
 };
 
 // The controller on the backend the config asks for (mppi/make_controller.hpp).
+struct BuiltController {
+  std::unique_ptr<Controller> controller;
+  std::string backend;
+};
+
 template <class D>
-std::unique_ptr<Controller> build_controller(const ClosedLoopConfig& config, const D& model,
+BuiltController build_controller(const ClosedLoopConfig& config, const D& model,
                                              const AutoRallyCost& cost) {
   BackendReport report;
   auto controller = std::make_unique<Controller>(
       mppi::make_controller(model, cost, config.controller, config.backend, &report));
+  if (config.inject_device_loss_at_step >= 0)
+    controller->inject_device_loss(static_cast<std::uint64_t>(config.inject_device_loss_at_step));
   if (config.progress)
     std::fprintf(stderr, "backend: %s%s%s (%s)\n", report.backend.c_str(),
                  report.device.empty() ? "" : " on ", report.device.c_str(), report.reason.c_str());
   if (config.backend_report) *config.backend_report = report;
-  return controller;
+  return {std::move(controller), report.backend};
 }
 
 template <class M, class Observe>
 ControllerSetup controller_setup(const ClosedLoopConfig& config, const M& model, const AutoRallyCost& cost,
                                  Observe observe) {
   ControllerSetup setup;
-  setup.controller = build_controller(config, model, cost);
+  BuiltController built = build_controller(config, model, cost);
+  setup.controller = std::move(built.controller);
+  setup.backend = std::move(built.backend);
   setup.model_states = M::kNx;
   setup.observe = std::move(observe);
   if (config.observer) setup.predict = make_path_predictor(model, config.controller.dt_s);
@@ -162,7 +172,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
         config.out_dir + "/log.csv",
         std::vector<std::string>{"roll", "applied_steer", "applied_throttle", "progress_m",
                                  "lap", "optimizer_ms", "effective_sample_size", "min_cost",
-                                 "slip_angle_rad", "lateral_accel_mps2"},
+                                 "slip_angle_rad", "lateral_accel_mps2", "step_status", "backend_switches"},
         std::vector<std::pair<std::string, std::string>>{
             {"source", "mppi-sim"}, {"track", track.name()}, {"model", config.model},
             {"plant", config.plant}, {"seed", std::to_string(config.controller.seed)},
@@ -178,6 +188,8 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   summary.samples = config.controller.num_samples;
   summary.horizon = config.controller.horizon;
   summary.target_speed_mps = config.target_speed_mps;
+  summary.backend = setup.backend;
+  long control_step = 0;
 
   std::vector<float> model_x(static_cast<std::size_t>(setup.model_states));
   std::vector<double> optimizer_ms, ess;
@@ -218,6 +230,15 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
     }
     setup.observe(plant.state(), P::kNx, model_x.data());
     const auto u = controller->step(model_x, &step_summary);
+    if (step_summary.status != StepStatus::kOk) ++summary.failed_steps;
+    if (step_summary.backend_switched) {
+      const Controller::BackendSwitch& b = controller->backend_switches().back();
+      summary.backend_switches.push_back({control_step, t, b.from, b.to, b.reason});
+      if (config.progress)
+        std::fprintf(stderr, "  control step %ld (t = %.2f s): switched from the %s to the %s backend: %s\n",
+                     control_step, t, b.from.c_str(), b.to.c_str(), b.reason.c_str());
+    }
+    ++control_step;
     // As on the real car, the controller's output reaches the plant through the chassis
     // interface (command validation, priorities, runstop, watchdog, calibration to pulse
     // widths and back through the simulated servos); through_chassis = false bypasses it.
@@ -273,7 +294,8 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
       const double extras[] = {s.roll_rad, plant.applied().steer, plant.applied().throttle,
                                laps.progress_m(), static_cast<double>(laps.laps_completed()),
                                step_summary.optimizer_ms, step_summary.effective_sample_size,
-                               step_summary.min_cost, slip, lat_accel};
+                               step_summary.min_cost, slip, lat_accel, static_cast<double>(step_summary.status),
+                               static_cast<double>(summary.backend_switches.size())};
       log->write(t, s, command, extras);
     }
     if (config.observer)

@@ -48,6 +48,10 @@ struct ClosedLoopConfig {
   double plant_dt_s = 0.002;              // plant integration step (500 Hz)
   std::string out_dir;                    // log.csv, track.png, summary.json; empty = none
   bool progress = true;                   // print a line per lap to stderr
+  // Fault drill: the backend fails like a lost GPU device after this many control steps
+  // (Controller::inject_device_loss); the controller then goes on on its fallback (the CPU
+  // backend for a GPU run) and the summary records the switch. -1 = never.
+  long inject_device_loss_at_step = -1;
   bool through_chassis = true;            // controller -> chassis adapter (priorities, runstop,
                                           // watchdog, calibration) -> plant; false = direct
   StepObserver* observer = nullptr;       // sees every step, brings the operator's requests

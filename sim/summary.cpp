@@ -41,6 +41,12 @@ std::string to_json(const RunSummary& s) {
   j["optimizer_ms_p50"] = number(s.optimizer_ms_p50);
   j["optimizer_ms_p99"] = number(s.optimizer_ms_p99);
   j["effective_sample_size_mean"] = number(s.effective_sample_size_mean);
+  j["backend"] = s.backend;
+  j["failed_steps"] = s.failed_steps;
+  j["backend_switches"] = nlohmann::ordered_json::array();
+  for (const BackendSwitchRecord& b : s.backend_switches)
+    j["backend_switches"].push_back({{"control_step", b.control_step}, {"time_s", number(b.time_s)},
+                                     {"from", b.from}, {"to", b.to}, {"reason", b.reason}});
   return j.dump(2) + "\n";
 }
 

@@ -6,6 +6,14 @@
 
 namespace mppi::sim {
 
+// The controller left a failed backend for its fallback (a lost GPU -> the CPU backend).
+struct BackendSwitchRecord {
+  long control_step = 0;  // 0-based index of the control step that failed
+  double time_s = 0.0;    // simulated time of that step
+  std::string from, to;   // backend names
+  std::string reason;     // the failure
+};
+
 struct RunSummary {
   std::string track;                  // "gazebo", ...
   std::string model;                  // the controller's dynamics model
@@ -30,6 +38,9 @@ struct RunSummary {
   double optimizer_ms_p50 = 0.0;      // wall time of one controller step, median
   double optimizer_ms_p99 = 0.0;
   double effective_sample_size_mean = 0.0;
+  std::string backend;                // the backend the run started on ("cpu", "vulkan")
+  int failed_steps = 0;               // control steps that returned the safe control
+  std::vector<BackendSwitchRecord> backend_switches;
 };
 
 // Pretty-printed JSON object with one key per field above (same names). NaN / inf -> null.

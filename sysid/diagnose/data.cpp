@@ -8,7 +8,8 @@
 
 namespace mppi::diagnose {
 
-DiagData prepare(const sim::Recording& rec, const std::string& source, std::size_t min_rows) {
+DiagData prepare(const sim::Recording& rec, const std::string& source, std::size_t min_rows,
+                 const ScreenOptions& screen) {
   DiagData d;
   d.source = source;
   for (const auto& c : sim::kRecordingRequiredColumns)
@@ -37,15 +38,24 @@ DiagData prepare(const sim::Recording& rec, const std::string& source, std::size
   std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
   d.dt_s = dts[dts.size() / 2];
   if (!(d.dt_s > 0)) throw Error(source + ": cannot determine the sample interval");
-  // Pieces: cut at NaN rows, gaps > 3 median intervals, and position jumps no car makes.
+  std::vector<ScreenColumn> columns = {{"t", &d.t},   {"x", &d.x},   {"y", &d.y},
+                                       {"yaw", &d.yaw}, {"vx", &d.vx}, {"vy", &d.vy},
+                                       {"yaw_rate", &d.r}, {"steer", &d.steer}, {"throttle", &d.throttle}};
+  if (!d.roll.empty()) columns.push_back({"roll", &d.roll});
+  d.flags = screen_columns(d.t, columns, screen);
+  for (ScreenFlag& f : d.flags) f.file = source;
+  const std::vector<char> screened = screened_rows(n, d.flags, screen.guard_rows);
+  // Pieces: cut at NaN rows, screened rows, gaps > 3 median intervals, and position jumps no
+  // car makes.
   d.piece.assign(n, -1);
   int id = -1;
   bool open = false;
   std::size_t usable = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const double vals[] = {d.t[k], d.x[k], d.y[k], d.yaw[k], d.vx[k], d.vy[k], d.r[k], d.steer[k], d.throttle[k]};
-    bool ok = true;
+    bool ok = !screened[k];
     for (double v : vals) ok = ok && std::isfinite(v);
+    if (screened[k]) ++d.screened_rows;
     if (!ok) {
       open = false;
       continue;
@@ -96,6 +106,11 @@ DiagData concat(const DiagData& a, const DiagData& b) {
   if (!a.roll.empty() && !b.roll.empty()) append(d.roll, b.roll, 0);
   else d.roll.clear();  // roll only where both recordings have it
   for (int p : b.piece) d.piece.push_back(p < 0 ? -1 : p + max_piece + 1);
+  for (ScreenFlag f : b.flags) {
+    f.row += a.rows();
+    d.flags.push_back(std::move(f));
+  }
+  d.screened_rows += b.screened_rows;
   return d;
 }
 

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "sim/recording.hpp"
+#include "sysid/diagnose/screen.hpp"
 
 namespace mppi::diagnose {
 
@@ -23,6 +24,9 @@ struct DiagData {
   // row k+1 the command that produced it (lead 1); real recordings the command sent at t[k] (0).
   int control_lead = 0;
   std::vector<int> piece;                   // piece id per row (-1 = unusable row)
+  // Values screened out (screen.hpp): each flag's row and its guard rows have piece -1.
+  std::vector<ScreenFlag> flags;
+  std::size_t screened_rows = 0;            // rows made unusable by the flags
   double dt_s = 0.02;                       // median sample interval
   std::size_t rows() const { return t.size(); }
   double channel(int c, std::size_t k) const { return c == 0 ? vx[k] : c == 1 ? vy[k] : r[k]; }
@@ -36,7 +40,9 @@ struct DiagData {
 };
 
 // Throws mppi::Error naming the file for missing columns, fewer than `min_rows` (at least 2) usable rows.
-DiagData prepare(const sim::Recording& rec, const std::string& source, std::size_t min_rows = 250);
+// Screens the values first (screen.hpp): flagged rows are listed in `flags` and kept out.
+DiagData prepare(const sim::Recording& rec, const std::string& source, std::size_t min_rows = 250,
+                 const ScreenOptions& screen = {});
 
 // Reads and prepares a recording file (sim::RecordingReader, then prepare()).
 DiagData load_recording(const std::string& path);

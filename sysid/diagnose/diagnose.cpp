@@ -23,6 +23,21 @@ using json = nlohmann::ordered_json;
 
 json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
+// The values screened out of the recording (screen.hpp); at most kMaxListedFlags listed.
+constexpr std::size_t kMaxListedFlags = 200;
+json screening_json(const DiagData& d) {
+  json flags = json::array();
+  for (std::size_t i = 0; i < d.flags.size() && i < kMaxListedFlags; ++i) {
+    const ScreenFlag& f = d.flags[i];
+    // The value as text: JSON has no NaN or inf.
+    char value[32];
+    std::snprintf(value, sizeof value, "%.6g", f.value);
+    flags.push_back({{"file", f.file}, {"row", f.row}, {"t_s", num(f.t_s)}, {"column", f.column},
+                     {"value", value}, {"kind", f.kind}});
+  }
+  return {{"flagged", d.flags.size()}, {"rows_dropped", d.screened_rows}, {"flags", flags}};
+}
+
 json metrics_json(const std::vector<HorizonMetrics>& ms) {
   json out = json::array();
   for (const auto& m : ms) {
@@ -115,6 +130,7 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
   j["rows"] = d.rows();
   j["dt_s"] = d.dt_s;
   j["holdout"] = o.holdout;
+  j["screening"] = screening_json(d);
   j["selected"] = res.selection.selected;
   j["reliable"] = res.selection.reliable;
   j["verdict"] = res.selection.verdict;
@@ -217,7 +233,18 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
        << "- recording: `" << d.source << "` (" << d.rows() << " rows, dt " << d.dt_s << " s), held out: `" << o.holdout
        << "`\n- nominal model: " << nominal.name() << (o.params_source.empty() ? " (library defaults)" : " from `" + o.params_source + "`")
        << "\n- corrected model: " << (res.model_file.empty() ? std::string("none written") : "`" + res.model_file + "`")
-       << "\n- verdict: **" << res.selection.verdict << "**\n\n## Named effects\n\n";
+       << "\n- verdict: **" << res.selection.verdict << "**\n\n";
+    if (!d.flags.empty()) {
+      md << "## Screened values (kept out of the fits)\n\n" << d.flags.size() << " values flagged; "
+         << d.screened_rows << " rows dropped with their neighbours.\n\n| file | row | t [s] | column | value | kind |\n|---|---|---|---|---|---|\n";
+      for (std::size_t i = 0; i < d.flags.size() && i < kMaxListedFlags; ++i) {
+        const ScreenFlag& f = d.flags[i];
+        md << "| " << f.file << " | " << f.row << " | " << f.t_s << " | " << f.column << " | " << f.value << " | " << f.kind << " |\n";
+      }
+      if (d.flags.size() > kMaxListedFlags) md << "\n(first " << kMaxListedFlags << " listed; all in the counts)\n";
+      md << "\n";
+    }
+    md << "## Named effects\n\n";
     auto inclusion = [&](const std::string& id) {
       for (const auto& c : res.selection.candidates)
         if (c.id == id && c.inclusion_frequency >= 0) return " (chosen in " + std::to_string(std::lround(100 * c.inclusion_frequency)) + " % of resamples)";

@@ -71,3 +71,31 @@ np.savez_compressed(
     dynamics_W1=np.zeros((32, 6), np.float32), dynamics_b1=np.zeros(32, np.float32),
     dynamics_W2=np.zeros((16, 32), np.float32), dynamics_b2=np.zeros(16, np.float32),
     dynamics_W3=np.zeros((4, 16), np.float32), dynamics_b3=np.zeros(4, np.float32))
+
+# Non-finite values in well-formed files (tests/mppi/test_nonfinite_inputs.cpp): the loaders must
+# refuse them, naming the file and the array.
+# AutoRally network, right shapes, float32 zeros except dynamics_b2[5] = NaN.
+b2 = np.zeros(32, np.float32)
+b2[5] = np.nan
+np.savez("autorally_nan.npz",
+         dynamics_W1=np.zeros((32, 6), np.float32), dynamics_b1=np.zeros(32, np.float32),
+         dynamics_W2=np.zeros((32, 32), np.float32), dynamics_b2=b2,
+         dynamics_W3=np.zeros((4, 32), np.float32), dynamics_b3=np.zeros(4, np.float32))
+# float64 1e300 in dynamics_W3[1, 2]: finite as a double, infinite as the float the model uses.
+W3 = np.zeros((4, 32))
+W3[1, 2] = 1e300
+np.savez("autorally_overflow.npz",
+         dynamics_W1=np.zeros((32, 6)), dynamics_b1=np.zeros(32),
+         dynamics_W2=np.zeros((32, 32)), dynamics_b2=np.zeros(32),
+         dynamics_W3=W3, dynamics_b3=np.zeros(4))
+# Cost map (AutoRally layout): x in [0, 2] m, y in [0, 1] m, 2 pixels per metre -> 4 x 2 cells,
+# channel0 row-major by y; cell (row 1, col 1) = index 5 is NaN, cell (row 0, col 3) = +inf in
+# costmap_inf.npz.
+c = np.arange(8, dtype=np.float32)
+c[5] = np.nan
+np.savez("costmap_nan.npz", xBounds=np.array([0.0, 2.0]), yBounds=np.array([0.0, 1.0]),
+         pixelsPerMeter=np.array([2.0]), channel0=c)
+c = np.arange(8, dtype=np.float32)
+c[3] = np.inf
+np.savez("costmap_inf.npz", xBounds=np.array([0.0, 2.0]), yBounds=np.array([0.0, 1.0]),
+         pixelsPerMeter=np.array([2.0]), channel0=c)
