@@ -471,7 +471,7 @@ void register_sysid(py::module_& m) {
         "the GIL.");
   m.def("diagnose_synth_open_loop",
         [](const std::string& effects, std::uint64_t seed, double duration_s, double noise_scale,
-           const std::string& out_path) {
+           const std::string& out_path, const std::string& model) {
           mppi::EffectParams truth;
           const std::vector<std::string> ids = mppi::diagnose::parse_effect_assignments(effects, &truth);
           mppi::diagnose::SensorNoise noise;
@@ -479,14 +479,14 @@ void register_sysid(py::module_& m) {
           mppi::sim::Recording r;
           {
             py::gil_scoped_release release;
-            r = mppi::diagnose::synthesize_open_loop(truth, seed, duration_s, noise);
+            r = mppi::diagnose::synthesize_open_loop(truth, seed, duration_s, noise, model);
             if (!out_path.empty()) write_recording(r, out_path);
           }
           return py::make_tuple(recording_dict(r), ids);
         },
         py::arg("effects") = "", py::arg("seed") = 1, py::arg("duration_s") = 40.0, py::arg("noise_scale") = 1.0,
-        py::arg("out_path") = "",
+        py::arg("out_path") = "", py::arg("model") = mppi::models::SingleTrackModel::kName,
         "a fast synthetic recording with hidden effects ('key=value,...', e.g. 'steer_delay_s=0.08'): the "
         "truth plant driven open loop on open ground (the diagnose tests' generator). Returns (recording dict, "
-        "effect ids); writes it to out_path when given.");
+        "effect ids); writes it to out_path when given; model: the truth plant's nominal model.");
 }

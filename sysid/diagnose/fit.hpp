@@ -73,6 +73,9 @@ struct SelectionOptions {
   // A time-indexed change is named only when no state-dependent candidate explains at least
   // this share of its validation improvement.
   double time_change_dominance = 0.8;
+  // Parsimony: a candidate with fewer parameters is preferred when its validation improvement is
+  // at least this share of the best one's.
+  double parsimony_share = 0.9;
 };
 
 struct CandidateReport {

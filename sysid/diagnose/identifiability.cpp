@@ -27,10 +27,11 @@ double percentile(std::vector<double> v, double q) {
 
 // Thresholds below which a channel counts as not excited. Chosen from what a car that only
 // drives straight or at constant throttle shows with sensor noise (a few hundredths) and well
-// below what any manoeuvre gives (a turn: steer std > 0.1, |ay| > 3 m/s^2).
+// below what any manoeuvre gives (a turn: steer std > 0.1, |ay| > 3 m/s^2). A speed range of 1 m/s
+// at 5 m/s already changes a v^2 force by 40 %.
 constexpr double kMinSteerStd = 0.05, kMinYawRateStd = 0.05;
 constexpr double kMinThrottleStd = 0.05, kMinVxStd = 0.2;
-constexpr double kMinLateralAccel = 2.0, kMinSpeedRange = 1.5, kMinLongitudinalAccelStd = 0.8;
+constexpr double kMinLateralAccel = 2.0, kMinSpeedRange = 1.0, kMinLongitudinalAccelStd = 0.8;
 
 std::string format(const char* fmt, double a, double b) {
   char buf[200];

@@ -35,8 +35,9 @@ struct GreedyResult {
 };
 
 // Greedy forward selection over `pool` (indices into cands): each round fits every remaining
-// candidate on top of what is chosen and takes the one with the lowest BIC among those that
-// lower the validation cost enough and the BIC too, with identified parameters; a time-indexed change
+// candidate on top of what is chosen and takes the one that lowers the validation cost most (the
+// simplest among those nearly as good) among those that lower it enough and the BIC too, with
+// identified parameters; a time-indexed change
 // gives way to a state-dependent candidate that explains most of the same.
 GreedyResult greedy(const FitProblem& fit, const FitProblem& val, const std::vector<const EffectSpec*>& cands,
                     const std::vector<int>& pool, const SelectionOptions& opt, double n_eff,
@@ -71,9 +72,19 @@ GreedyResult greedy(const FitProblem& fit, const FitProblem& val, const std::vec
     std::vector<const CandidateFit*> order;
     for (const auto& c : tried)
       if (c.passes) order.push_back(&c);
-    // Among those that hold on later data, the information criterion on the fit part ranks: an
-    // effect with fewer parameters that fits as well wins (c v^2 over F0 + b v on a speed range).
-    std::sort(order.begin(), order.end(), [](const CandidateFit* a, const CandidateFit* b) { return a->bic < b->bic; });
+    // Ranked by how much they help on later data; among those within parsimony_share of the
+    // best, the one with the fewest parameters comes first (c v^2 over F0 + b v on a speed range).
+    std::sort(order.begin(), order.end(),
+              [](const CandidateFit* a, const CandidateFit* b) { return a->improvement > b->improvement; });
+    if (!order.empty()) {
+      const double near_best = opt.parsimony_share * order.front()->improvement;
+      auto params_of = [&](const CandidateFit* c) { return cands[static_cast<std::size_t>(c->index)]->params.size(); };
+      std::stable_sort(order.begin(), order.end(), [&](const CandidateFit* a, const CandidateFit* b) {
+        const bool na = a->improvement >= near_best, nb = b->improvement >= near_best;
+        if (na != nb) return na;
+        return na && params_of(a) < params_of(b);
+      });
+    }
     const CandidateFit* pick = nullptr;
     for (const CandidateFit* c : order) {
       const EffectSpec& spec = *cands[static_cast<std::size_t>(c->index)];

@@ -57,7 +57,7 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.p95_slip_angle_rad = 0.125;
   s.peak_lateral_accel_mps2 = 6.5;
   const auto j = nlohmann::json::parse(to_json(s));
-  CHECK(j.size() == 21);
+  CHECK(j.size() == 24);
   CHECK(j.at("track") == "gazebo");
   CHECK(j.at("model") == "nn_autorally");
   CHECK(j.at("plant") == "single_track");
