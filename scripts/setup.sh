@@ -16,6 +16,11 @@ MPPI_DEBIAN_PACKAGES=(
 mppi_missing_packages() {
   local missing=()
   for p in "${MPPI_DEBIAN_PACKAGES[@]}"; do
+    # Machines that ship their own Node.js (not Debian's) conflict with Debian's npm; any working
+    # node and npm on PATH serve the vendored web assets equally.
+    if { [ "$p" = nodejs ] || [ "$p" = npm ]; } && command -v node >/dev/null && command -v npm >/dev/null; then
+      continue
+    fi
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   echo "${missing[@]:-}"
