@@ -4,7 +4,7 @@
 // forward<W>() is hot-loop code (no allocation, no exceptions, branch-free over lanes); it is
 // built as "for each block of output neurons, for each input: acc[k][lanes] += w[k] * a[lanes]",
 // so the lane loop is innermost and compiles to broadcast-FMA over vectors.
-// Speed (Zen 4, one core, W = 64, AutoRally's 6-32-32-4 tanh net): ~47 ns per sample, of which
+// Speed (Zen 5, one core, W = 64, AutoRally's 6-32-32-4 tanh net): ~47 ns per sample, of which
 // ~19 ns is fast_tanh. fast_tanh's float clamp only vectorises on AVX2/SSE with
 // -fno-trapping-math (mppi::core sets it); without it the same net takes ~160 ns on AVX2.
 #include <bit>
@@ -75,7 +75,7 @@ class Mlp {
  private:
   // dense() works on blocks of kOutBlock output neurons x kLaneBlock lanes: each load of an
   // input row segment feeds kOutBlock FMAs, and the 4 x 16 accumulators stay in registers as
-  // independent FMA chains (AVX-512: 4 zmm, AVX2: 8 ymm). Measured on Zen 4 for the 6-32-32-4
+  // independent FMA chains (AVX-512: 4 zmm, AVX2: 8 ymm). Measured on Zen 5 for the 6-32-32-4
   // net at W = 64, the matrix part took ~30 ns/sample against ~45 for one neuron x 64 lanes.
   static constexpr int kOutBlock = 4;
   template <int W>

@@ -92,7 +92,7 @@ inline void philox_words(std::uint32_t k0, std::uint32_t k1, std::uint32_t itera
 #pragma GCC diagnostic ignored "-Wuninitialized"
 // The auto-vectorised loop above widens every 32 x 32 -> 64-bit product to 64-bit lanes; these
 // keep 32-bit lanes (mullo for the low words, two vpmuludq + a shuffle/blend for the high
-// words). The AVX-512 one is 2.2x faster per word than the auto-vectorised loop on Zen 4. The
+// words). The AVX-512 one is 2.2x faster per word than the auto-vectorised loop on Zen 5. The
 // path is chosen at run time (philox_words_dispatch), so the library still runs on any x86-64.
 
 // One Philox round on 16 lanes. High words: vpmuludq on the even lanes and on the odd lanes
