@@ -83,8 +83,8 @@ estimate dart_alm real/dart_jetracer.zip:car_1_Datarecording_09_16_2024_10_27_02
   --measure x,y,yaw,vx,vy,yaw_rate --fit 0:85 --validate 85:105
 
 # The DART sim-vs-real diagnosis (docs/DIAGNOSE.md): report, figures and report.html, written to
-# out/ and copied into docs/diagnose/dart only with --diagnose-docs, because the diagnosis
-# itself (not its figures) has changed since docs/diagnose/dart was written.
+# out/, or into docs/diagnose/dart with --diagnose-docs (the numbers quoted in docs/DIAGNOSE.md
+# and the README come from that report: update them with it).
 dart_out="$out/dart"
 [ "$diagnose_docs" = 1 ] && dart_out=docs/diagnose/dart
 echo "[docs_figures] mppi-fit diagnose (DART) -> $dart_out"
