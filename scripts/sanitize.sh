@@ -55,7 +55,7 @@ run_asan() {
 }
 
 run_tsan() {
-  export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1"
+  export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/tests/tsan.supp"
   local t0=$SECONDS
   build-tsan/bin/mppi-thread-tests
   echo "[sanitize] TSan threaded tests ran in $((SECONDS - t0)) s"

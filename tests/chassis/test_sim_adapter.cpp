@@ -64,7 +64,7 @@ TEST_CASE("a closed-loop run through the chassis adapter laps exactly like the d
   // The kinematic controller cannot hold the calibrated car (its grip-limited turns); the path
   // through the adapter is what is tested here, on the gentler uncalibrated plant.
   c.plant_params_yaml = mppi::test::data_path("config/autorally_single_track_uncalibrated.yaml");
-  c.target_speed_mps = 5.0;
+  c.target_speed_mps = 4.0;
   c.laps = 1;
   c.controller.num_samples = 256;
   c.controller.horizon = 50;
@@ -74,6 +74,7 @@ TEST_CASE("a closed-loop run through the chassis adapter laps exactly like the d
   const auto adapter = mppi::sim::run_closed_loop(c);
   c.through_chassis = false;
   const auto direct = mppi::sim::run_closed_loop(c);
+  INFO("adapter: laps " << adapter.laps_completed << " crashes " << adapter.crashes << " t " << adapter.sim_time_s << " direct laps " << direct.laps_completed << " crashes " << direct.crashes);
   REQUIRE(adapter.laps_completed == 1);
   CHECK(adapter.lap_times_s == direct.lap_times_s);
   CHECK(adapter.crashes == direct.crashes);
