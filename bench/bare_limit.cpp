@@ -44,24 +44,20 @@ typedef float v16 __attribute__((vector_size(64)));
 inline void load(v16& v, const float* p) { __builtin_memcpy(&v, p, sizeof v); }
 inline void store(float* p, const v16& v) { __builtin_memcpy(p, &v, sizeof v); }
 
-// mppi::fast_tanh on 16 lanes at once, in place (the same [13/6] rational, as GCC vector
-// operations; by reference for the same ABI reason as load/store).
+// mppi::fast_tanh96 on 16 lanes at once, in place (the same rational, as GCC vector operations;
+// by reference for the same ABI reason as load/store).
 inline void tanh_v16(v16& v) {
-  v16 x = v;
-  const v16 c = v16{} + 7.90531110763549805f;
-  x = x < c ? x : c;
+  const v16 c = v16{} + kTanhClamp;
+  v16 x = v < c ? v : c;
   x = x > -c ? x : -c;
   const v16 x2 = x * x;
-  v16 p = x2 * -2.76076847742355e-16f + 2.00018790482477e-13f;
-  p = p * x2 - 8.60467152213735e-11f;
-  p = p * x2 + 5.12229709037114e-08f;
-  p = p * x2 + 1.48572235717979e-05f;
-  p = p * x2 + 6.37261928875436e-04f;
-  p = p * x2 + 4.89352455891786e-03f;
-  p = p * x;
-  v16 q = x2 * 1.19825839466702e-06f + 1.18534705686654e-04f;
-  q = q * x2 + 2.26843463243900e-03f;
-  q = q * x2 + 4.89352518554385e-03f;
+  v16 p = x2 * kTanhP[4] + kTanhP[3];
+  p = p * x2 + kTanhP[2];
+  p = p * x2 + kTanhP[1];
+  p = (p * x2 + kTanhP[0]) * x;
+  v16 q = x2 + kTanhQ[2];
+  q = q * x2 + kTanhQ[1];
+  q = q * x2 + kTanhQ[0];
   v = p / q;
 }
 

@@ -5,7 +5,7 @@
 // back into its 4 state inputs, so every step depends on the last and nothing can be optimised
 // away. Hand-tuned: 64-lane chunks as 4 x 16-float vectors (one AVX-512 register each), every
 // layer as blocks of 4 units x 4 vectors = 16 accumulators kept in registers with broadcast
-// weights, tanh (mppi::fast_tanh's rational) applied to the accumulators before they are
+// weights, tanh (mppi::fast_tanh96's rational) applied to the accumulators before they are
 // stored, OpenMP over chunks, MPPI_MULTIVERSION so the x86-64-v4 clone runs on AVX-512 machines.
 // bf16 = true: the same with bf16 hidden layers (bare_limit_bf16.cpp).
 // It is the yardstick for BM_MppiIteration: what the hardware can do for the network alone.

@@ -4,7 +4,7 @@
 // forward<W>() is hot-loop code (no allocation, no exceptions, branch-free over lanes); it is
 // built as "for each block of output neurons, for each input: acc[k][lanes] += w[k] * a[lanes]",
 // so the lane loop is innermost and compiles to broadcast-FMA over vectors.
-// That portable code runs on every CPU; fast_tanh's float clamp only vectorises on AVX2/SSE with
+// That portable code runs on every CPU; fast_tanh96's float clamp only vectorises on AVX2/SSE with
 // -fno-trapping-math (mppi::core sets it); without it the 6-32-32-4 net takes ~160 ns on AVX2.
 // On a CPU with AVX-512 (checked once, at construction) forward<W>() for W a multiple of 16
 // calls the register-blocked AVX-512 kernel instead (dynamics/mlp_avx512_kernels.hpp: 16
@@ -136,7 +136,7 @@ class Mlp {
     switch (act) {  // per layer, not per lane
       case Activation::kTanh:
         MPPI_SIMD_LOOP
-        for (int j = 0; j < LB; ++j) d[j] = fast_tanh(acc[j]);
+        for (int j = 0; j < LB; ++j) d[j] = fast_tanh96(acc[j]);
         break;
       case Activation::kRelu:
         // max(x, 0) on the bits: clear x if its sign bit is set. Integer ops vectorise with

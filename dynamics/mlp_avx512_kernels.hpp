@@ -32,27 +32,23 @@
 namespace mppi::detail {
 namespace {
 
-// tanh as in mppi::fast_tanh ([13/6] rational on a clamped argument, max abs error 3.5e-7).
+// mppi::fast_tanh96 ([9/6] rational on a clamped argument, max abs error 4.5e-7).
 MPPI_MLP_TARGET inline __m512 tanh_fp32(__m512 x) {
-  const __m512 c = _mm512_set1_ps(7.90531110763549805f);
+  const __m512 c = _mm512_set1_ps(kTanhClamp);
   x = _mm512_min_ps(_mm512_max_ps(x, _mm512_sub_ps(_mm512_setzero_ps(), c)), c);
   const __m512 x2 = _mm512_mul_ps(x, x);
-  __m512 p = _mm512_set1_ps(-2.76076847742355e-16f);
-  p = _mm512_fmadd_ps(p, x2, _mm512_set1_ps(2.00018790482477e-13f));
-  p = _mm512_fmadd_ps(p, x2, _mm512_set1_ps(-8.60467152213735e-11f));
-  p = _mm512_fmadd_ps(p, x2, _mm512_set1_ps(5.12229709037114e-08f));
-  p = _mm512_fmadd_ps(p, x2, _mm512_set1_ps(1.48572235717979e-05f));
-  p = _mm512_fmadd_ps(p, x2, _mm512_set1_ps(6.37261928875436e-04f));
-  p = _mm512_fmadd_ps(p, x2, _mm512_set1_ps(4.89352455891786e-03f));
+  __m512 p = _mm512_fmadd_ps(_mm512_set1_ps(kTanhP[4]), x2, _mm512_set1_ps(kTanhP[3]));
+  p = _mm512_fmadd_ps(p, x2, _mm512_set1_ps(kTanhP[2]));
+  p = _mm512_fmadd_ps(p, x2, _mm512_set1_ps(kTanhP[1]));
+  p = _mm512_fmadd_ps(p, x2, _mm512_set1_ps(kTanhP[0]));
   p = _mm512_mul_ps(p, x);
-  __m512 q = _mm512_set1_ps(1.19825839466702e-06f);
-  q = _mm512_fmadd_ps(q, x2, _mm512_set1_ps(1.18534705686654e-04f));
-  q = _mm512_fmadd_ps(q, x2, _mm512_set1_ps(2.26843463243900e-03f));
-  q = _mm512_fmadd_ps(q, x2, _mm512_set1_ps(4.89352518554385e-03f));
+  __m512 q = _mm512_add_ps(x2, _mm512_set1_ps(kTanhQ[2]));
+  q = _mm512_fmadd_ps(q, x2, _mm512_set1_ps(kTanhQ[1]));
+  q = _mm512_fmadd_ps(q, x2, _mm512_set1_ps(kTanhQ[0]));
   return _mm512_div_ps(p, q);
 }
 
-// tanh_bf16 of mppi/fast_math.hpp: [5/4] rational, 6 multiply-adds and a division.
+// mppi::fast_tanh_lowp: [5/4] rational, 5 multiplies or FMAs, one add and a division.
 MPPI_MLP_TARGET inline __m512 tanh_lowp(__m512 x) {
   const __m512 c = _mm512_set1_ps(kTanhLowpClamp);
   x = _mm512_min_ps(_mm512_max_ps(x, _mm512_sub_ps(_mm512_setzero_ps(), c)), c);
