@@ -5,8 +5,8 @@
 // merge at link time. Not a public header.
 //
 // Blocking: 4 output neurons x 64 lanes (4 zmm) = 16 accumulators in registers, independent
-// FMA chains, each weight broadcast from memory (embedded broadcast) once per block row and
-// each input vector loaded once per 4 outputs. Remainders: 2 and 1 output neurons, 16-lane
+// FMA chains; per input, 4 vector loads and 4 weight broadcasts (vbroadcastss / vpbroadcastd
+// from memory) feed 16 FMAs. Remainders: 2 and 1 output neurons, 16-lane
 // blocks when the width is not a multiple of 64. The activation is applied to the accumulators
 // before they are stored (no second pass over the layer).
 //
