@@ -50,6 +50,11 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
       ->type_name("FILE");
   app.add_option("--network", c.network_npz, "weights (.npz) of a learned model, when no --*-params file is given")
       ->type_name("FILE");
+  app.add_option("--nn-precision", c.nn_precision,
+                 "CPU backend: arithmetic of the controller network's hidden layers, fp32 | bf16 (bf16 on "
+                 "CPUs with AVX512-BF16, else fp32; docs/BENCHMARKS.md section 5)")
+      ->type_name("P")
+      ->check(CLI::IsMember({"fp32", "bf16"}).name("P").description(""));
   app.add_option("--inject-device-loss-at-step", c.inject_device_loss_at_step,
                  "fault drill: the backend fails like a lost GPU after N control steps; the run goes on on the "
                  "CPU backend (summary.json: backend_switches)")

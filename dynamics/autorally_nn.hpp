@@ -49,6 +49,13 @@ class AutoRallyNetwork {
 
   const Mlp& network() const { return net_; }
 
+  // FP32 (the default) or bf16 hidden layers (Mlp::set_precision): bf16 roughly halves the
+  // network's arithmetic on CPUs with AVX512-BF16 and changes the derivatives by ~1e-2 of
+  // their spread (docs/BENCHMARKS.md, "Reduced precision"). Returns false and keeps FP32 where
+  // the CPU lacks AVX512-BF16. The choice is made once; step() then calls one kernel per chunk.
+  bool set_precision(NetPrecision precision) { return net_.set_precision(precision); }
+  NetPrecision precision() const { return net_.precision(); }
+
   std::size_t scratch_floats(int width) const {
     return static_cast<std::size_t>(kNetIn + kNetOut) * static_cast<std::size_t>(width) +
            net_.scratch_floats(width);

@@ -40,6 +40,31 @@ Mlp::Mlp(std::vector<DenseLayer> layers) : layers_(std::move(layers)) {
       throw Error(name + "has non-finite weights or biases");
     if (l + 1 < layers_.size()) max_hidden_ = std::max(max_hidden_, L.n_out);
   }
+  bf16_weights_.resize(layers_.size());
+  for (std::size_t l = 1; l < layers_.size(); ++l) {
+    const DenseLayer& L = layers_[l];
+    const int n_pairs = (L.n_in + 1) / 2;
+    std::vector<std::uint32_t>& packed = bf16_weights_[l];
+    packed.assign(static_cast<std::size_t>(L.n_out) * static_cast<std::size_t>(n_pairs), 0u);
+    for (int o = 0; o < L.n_out; ++o)
+      for (int i = 0; i < L.n_in; ++i) {
+        const std::uint32_t b = to_bf16_bits(L.weights[static_cast<std::size_t>(o) * L.n_in + i]);
+        packed[static_cast<std::size_t>(o) * n_pairs + i / 2] |= b << (16 * (i % 2));
+      }
+  }
+  kernel_ = cpu_supports(MlpKernel::kAvx512) ? MlpKernel::kAvx512 : MlpKernel::kPortable;
+}
+
+bool Mlp::set_kernel(MlpKernel kernel) {
+  if (!cpu_supports(kernel)) return false;
+  kernel_ = kernel;
+  return true;
+}
+
+bool Mlp::set_precision(NetPrecision precision) {
+  if (precision == NetPrecision::kBf16) return set_kernel(MlpKernel::kAvx512Bf16);
+  if (!set_kernel(MlpKernel::kAvx512)) kernel_ = MlpKernel::kPortable;
+  return true;
 }
 
 Mlp Mlp::from_npz(const NpzFile& npz, const std::string& prefix, const std::vector<Activation>& activations) {

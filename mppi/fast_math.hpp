@@ -27,6 +27,39 @@ inline float fast_tanh(float x) noexcept {
   return p / q;
 }
 
+// The same function with fewer operations, for the network kernels (dynamics/mlp.hpp,
+// dynamics/mlp_avx512_kernels.hpp): x P(x^2) / Q(x^2), an odd [9/6] minimax rational (Q
+// monic), same clamp: 8 multiplies or FMAs, one add and a division against 11 and one. Max abs
+// error 4.5e-7 (tests/mppi/test_fast_math.cpp). fast_tanh stays as it is: the GPU shaders
+// (kernels/shaders/common.glsl) repeat its operations for CPU/GPU parity.
+inline constexpr float kTanhClamp = 7.90531110763549805f;
+inline constexpr float kTanhP[5] = {5091.705421197275f, 647.0683863962777f, 13.712402210685147f,
+                                    0.036392489380047646f, -3.1233200292516504e-05f};
+inline constexpr float kTanhQ[3] = {5091.709733929966f, 2344.2891382644502f, 116.26454563674616f};  // + x^6
+inline float fast_tanh96(float x) noexcept {
+  x = clampf(x, -kTanhClamp, kTanhClamp);
+  const float x2 = x * x;
+  const float p = ((((kTanhP[4] * x2 + kTanhP[3]) * x2 + kTanhP[2]) * x2 + kTanhP[1]) * x2 + kTanhP[0]) * x;
+  const float q = ((x2 + kTanhQ[2]) * x2 + kTanhQ[1]) * x2 + kTanhQ[0];
+  return p / q;
+}
+
+// A cheaper tanh for the reduced-precision (bf16) network path, whose activations are rounded
+// to bf16 (relative error up to 2^-9 = 2e-3) right after it: x P(x^2) / Q(x^2), an odd [5/4]
+// minimax rational (Q monic), argument clamped to +-5. Max abs error 4.8e-5 over the real line
+// (tests/mppi/test_fast_math.cpp), 40x below the bf16 rounding that follows it. 5 multiplies or
+// FMAs, one add and a division, against 8, one and one for fast_tanh96.
+inline constexpr float kTanhLowpClamp = 5.0f;
+inline constexpr float kTanhLowpP[3] = {79.1047588133683f, 8.048281203772188f, 0.05181811641204074f};
+inline constexpr float kTanhLowpQ[2] = {79.1197826557108f, 34.377830018572396f};  // + x^4
+inline float fast_tanh_lowp(float x) noexcept {
+  x = clampf(x, -kTanhLowpClamp, kTanhLowpClamp);
+  const float x2 = x * x;
+  const float p = ((kTanhLowpP[2] * x2 + kTanhLowpP[1]) * x2 + kTanhLowpP[0]) * x;
+  const float q = (x2 + kTanhLowpQ[1]) * x2 + kTanhLowpQ[0];
+  return p / q;
+}
+
 }  // namespace mppi
 
 #include <bit>

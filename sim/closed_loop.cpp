@@ -105,6 +105,17 @@ BuiltController build_controller(const ClosedLoopConfig& config, const D& model,
   return {std::move(controller), report.backend};
 }
 
+// The controller model's network precision (ClosedLoopConfig::nn_precision).
+template <class M>
+void apply_nn_precision(const ClosedLoopConfig& config, M& model) {
+  if (config.nn_precision != "fp32" && config.nn_precision != "bf16")
+    throw Error("nn-precision must be fp32 or bf16, got '" + config.nn_precision + "'");
+  if constexpr (requires { model.set_precision(NetPrecision::kBf16); }) {
+    if (config.nn_precision == "bf16" && !model.set_precision(NetPrecision::kBf16) && config.progress)
+      std::fprintf(stderr, "nn-precision: this CPU has no AVX512-BF16, the network runs in fp32\n");
+  }
+}
+
 template <class M, class Observe>
 ControllerSetup controller_setup(const ClosedLoopConfig& config, const M& model, const AutoRallyCost& cost,
                                  Observe observe) {
@@ -124,7 +135,8 @@ ControllerSetup make_controller(const ClosedLoopConfig& config, const AutoRallyC
       return controller_setup(config, model, cost, std::move(observe));
     });
   return with_model(config.model, [&]<class D>() {
-    const typename D::Model model = D::load(model_file<D>(config.model_params_yaml, config.network_npz));
+    typename D::Model model = D::load(model_file<D>(config.model_params_yaml, config.network_npz));
+    apply_nn_precision(config, model);
     return controller_setup(config, model, cost, [model](const float* px, int plant_states, float* mx) {
       D::from_plant(model, px, plant_states, mx);
     });

@@ -41,6 +41,9 @@ struct ClosedLoopConfig {
   std::string plant_params_yaml;          // plant's data file; empty = its default (data/config)
   std::string model_params_yaml;          // controller model's data file; empty = its default
   std::string network_npz;                // weights (npz) for learned models; empty = the shipped ones
+  // Arithmetic of the controller's network hidden layers (models with set_precision: the
+  // AutoRally network): "fp32" or "bf16" (falls back to fp32, with a note, without AVX512-BF16).
+  std::string nn_precision = "fp32";
   // Grip and elevation by place (sim/surface_map.hpp, docs/SURFACES.md); empty = flat, grip 1.
   // Needs the single-track plant.
   std::string surface_yaml;

@@ -71,12 +71,13 @@ void random_net(const std::vector<int>& sizes, const std::vector<Activation>& ac
 
 template <int W>
 void check_against_reference(const std::vector<int>& sizes, const std::vector<Activation>& acts,
-                             unsigned seed) {
+                             unsigned seed, mppi::MlpKernel kernel = mppi::MlpKernel::kPortable) {
   std::mt19937 rng(seed);
   std::vector<RefLayer> ref;
   std::vector<DenseLayer> layers;
   random_net(sizes, acts, rng, &ref, &layers);
-  const Mlp mlp(layers);
+  Mlp mlp(layers);
+  REQUIRE(mlp.set_kernel(kernel));
   const int n_in = sizes.front(), n_out = sizes.back();
   REQUIRE(mlp.num_inputs() == n_in);
   REQUIRE(mlp.num_outputs() == n_out);
@@ -103,7 +104,8 @@ void check_against_reference(const std::vector<int>& sizes, const std::vector<Ac
       CHECK(y2[o] == Approx(y[o]).margin(1e-12));
     }
   }
-  INFO("layers " << sizes.size() - 1 << ", W " << W << ": max error " << max_err);
+  INFO("layers " << sizes.size() - 1 << ", W " << W << ", kernel " << static_cast<int>(kernel)
+                  << ": max error " << max_err);
   CHECK(max_err < 1e-6);  // observed ~2e-7 (float sums + fast_tanh)
   for (std::size_t i = static_cast<std::size_t>(n_out) * W; i < out.size(); ++i) CHECK(out[i] == kGuard);
   for (std::size_t i = scratch_n; i < scratch.size(); ++i) CHECK(scratch[i] == kGuard);
@@ -119,6 +121,128 @@ TEST_CASE("mlp: batched forward matches a double reference", "[nn]") {
   check_against_reference<8>({10, 33, 1}, {T, R}, 4);
   check_against_reference<13>({2, 40, 3, 40, 5}, {T, L, R, T}, 5);  // odd width, 4 layers
   check_against_reference<1>({1, 1}, {L}, 6);
+}
+
+TEST_CASE("mlp: the AVX-512 FP32 kernel matches a double reference", "[nn]") {
+  if (!Mlp::cpu_supports(mppi::MlpKernel::kAvx512)) {
+    WARN("no AVX-512 on this CPU: kernel not tested");
+    return;
+  }
+  const auto T = Activation::kTanh, R = Activation::kRelu, L = Activation::kLinear;
+  const auto K = mppi::MlpKernel::kAvx512;
+  check_against_reference<64>({6, 32, 32, 4}, {T, T, L}, 1, K);
+  check_against_reference<64>({7, 16, 9, 2}, {R, T, L}, 2, K);  // 9 = 4 + 4 + 1 neurons
+  check_against_reference<16>({3, 5}, {R}, 3, K);                // 5 = 4 + 1
+  check_against_reference<80>({10, 33, 1}, {T, R}, 4, K);         // 64 + 16 lanes
+  check_against_reference<128>({2, 40, 3, 40, 5}, {T, L, R, T}, 5, K);  // 3 = 2 + 1, 4 layers
+  check_against_reference<32>({1, 1}, {L}, 6, K);
+  check_against_reference<13>({6, 32, 32, 4}, {T, T, L}, 7, K);  // width not a multiple of 16: portable
+}
+
+TEST_CASE("mlp: forward<W> runs the kernel the CPU supports", "[nn]") {
+  Mlp mlp({DenseLayer{2, 3, std::vector<float>(6, 0.1f), std::vector<float>(3, 0.f), Activation::kTanh},
+            DenseLayer{3, 1, std::vector<float>(3, 0.5f), std::vector<float>(1, 0.f), Activation::kLinear}});
+  CHECK(mlp.precision() == mppi::NetPrecision::kFp32);
+  CHECK(mlp.kernel() == (Mlp::cpu_supports(mppi::MlpKernel::kAvx512) ? mppi::MlpKernel::kAvx512
+                                                                      : mppi::MlpKernel::kPortable));
+  const bool bf16 = Mlp::cpu_supports(mppi::MlpKernel::kAvx512Bf16);
+  CHECK(mlp.set_precision(mppi::NetPrecision::kBf16) == bf16);
+  CHECK(mlp.precision() == (bf16 ? mppi::NetPrecision::kBf16 : mppi::NetPrecision::kFp32));
+  CHECK(mlp.set_precision(mppi::NetPrecision::kFp32));
+  CHECK(mlp.precision() == mppi::NetPrecision::kFp32);
+  CHECK(mlp.set_kernel(mppi::MlpKernel::kPortable));
+  CHECK(mlp.kernel() == mppi::MlpKernel::kPortable);
+  // bf16 pairs: layer 2 has 3 inputs -> 2 words per row, the last one's high half 0
+  REQUIRE(mlp.bf16_weights(1).size() == 2);
+  CHECK(mlp.bf16_weights(1)[0] == (0x3f00u | 0x3f00u << 16));  // bf16(0.5) = 0x3f00
+  CHECK(mlp.bf16_weights(1)[1] == 0x3f00u);
+  CHECK(mlp.bf16_weights(0).empty());
+}
+
+namespace {
+// x rounded to bf16 (8 significant bits), to nearest, ties to even: the oracle for the bf16
+// kernel's rounding of weights and activations, written without the library's helper.
+double round_bf16(double x) {
+  if (x == 0) return 0;
+  int e = 0;
+  const double m = std::frexp(x, &e);  // |m| in [0.5, 1)
+  return std::ldexp(std::nearbyint(std::ldexp(m, 8)), e - 8);
+}
+
+// What the bf16 kernel computes, in double: layer 1 as is, later layers with bf16 weights and
+// bf16 inputs (the previous layer's activations rounded), sums exact.
+std::vector<double> reference_forward_bf16(std::vector<RefLayer> net, std::vector<double> a) {
+  for (std::size_t l = 0; l < net.size(); ++l) {
+    RefLayer& L = net[l];
+    if (l > 0) {
+      for (auto& row : L.w)
+        for (double& w : row) w = round_bf16(w);
+      for (double& v : a) v = round_bf16(v);
+    }
+    std::vector<double> z(L.b);
+    for (std::size_t o = 0; o < L.w.size(); ++o)
+      for (std::size_t i = 0; i < a.size(); ++i) z[o] += L.w[o][i] * a[i];
+    for (double& v : z) {
+      if (L.act == Activation::kTanh) v = std::tanh(v);
+      if (L.act == Activation::kRelu && v < 0) v = 0;
+    }
+    a = z;
+  }
+  return a;
+}
+
+// The bf16 kernel against (a) the bf16-rounding reference above, (b) the exact double network.
+template <int W>
+void check_bf16(const std::vector<int>& sizes, const std::vector<Activation>& acts, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::vector<RefLayer> ref;
+  std::vector<DenseLayer> layers;
+  random_net(sizes, acts, rng, &ref, &layers);
+  Mlp mlp(layers);
+  REQUIRE(mlp.set_precision(mppi::NetPrecision::kBf16));
+  const int n_in = sizes.front(), n_out = sizes.back();
+  std::uniform_real_distribution<float> xd(-2.f, 2.f);
+  std::vector<float> in(static_cast<std::size_t>(n_in) * W);
+  for (float& v : in) v = xd(rng);
+  constexpr float kGuard = 12345.f;
+  const std::size_t scratch_n = mlp.scratch_floats(W);
+  std::vector<float> out(static_cast<std::size_t>(n_out) * W + 16, kGuard);
+  std::vector<float> scratch(scratch_n + 16, kGuard);
+  mlp.forward<W>(in.data(), out.data(), scratch.data());
+  double err_rounded = 0, err_exact = 0;
+  for (int j = 0; j < W; ++j) {
+    std::vector<double> x(n_in);
+    for (int i = 0; i < n_in; ++i) x[i] = in[static_cast<std::size_t>(i) * W + j];
+    const std::vector<double> y_rounded = reference_forward_bf16(ref, x);
+    const std::vector<double> y_exact = reference_forward(ref, x);
+    for (int o = 0; o < n_out; ++o) {
+      const double v = out[static_cast<std::size_t>(o) * W + j];
+      err_rounded = std::max(err_rounded, std::abs(v - y_rounded[o]) / (1 + std::abs(y_rounded[o])));
+      err_exact = std::max(err_exact, std::abs(v - y_exact[o]) / (1 + std::abs(y_exact[o])));
+    }
+  }
+  INFO("layers " << sizes.size() - 1 << ", W " << W << ": max error against the bf16-rounding reference "
+                 << err_rounded << ", against the exact network " << err_exact);
+  // fast_tanh_lowp (4.8e-5) moves a few activations by one bf16 step (2^-8 relative) against
+  // std::tanh; observed up to ~1e-3. A wrongly packed pair or lane gives O(0.1 .. 1).
+  CHECK(err_rounded < 4e-3);
+  CHECK(err_exact < 2e-2);  // bf16 rounding itself: observed ~5e-3
+  for (std::size_t i = static_cast<std::size_t>(n_out) * W; i < out.size(); ++i) CHECK(out[i] == kGuard);
+  for (std::size_t i = scratch_n; i < scratch.size(); ++i) CHECK(scratch[i] == kGuard);
+}
+}  // namespace
+
+TEST_CASE("mlp: the bf16 kernel matches a bf16-rounding double reference", "[nn]") {
+  if (!Mlp::cpu_supports(mppi::MlpKernel::kAvx512Bf16)) {
+    WARN("no AVX512-BF16 on this CPU: kernel not tested");
+    return;
+  }
+  const auto T = Activation::kTanh, R = Activation::kRelu, L = Activation::kLinear;
+  check_bf16<64>({6, 32, 32, 4}, {T, T, L}, 11);  // the AutoRally shape
+  check_bf16<64>({7, 17, 9, 2}, {R, T, L}, 12);   // odd inputs of layers 2 and 3: padded pairs
+  check_bf16<16>({3, 5}, {R}, 13);                // one layer: FP32 only
+  check_bf16<80>({10, 33, 1}, {T, R}, 14);
+  check_bf16<128>({2, 40, 3, 40, 5}, {T, L, R, T}, 15);
 }
 
 TEST_CASE("mlp: relu and linear layers, hand-computed", "[nn]") {
