@@ -287,9 +287,16 @@ def main():
     check(n >= len(served) - 1 and not diff,
           f"served and reference runs agree on all {n} steps (first difference: {diff[:1]})")
 
-    # ---- 2. replay of the served run's log ----
+    # ---- 2. replay of a recording ----
+    # A recording of its own, 8 simulated seconds (the live run's log holds only the few seconds
+    # the checks above took in real time: too short a trail to count its pixels reliably).
+    replay_dir = os.path.join(work, "replay_source")
+    # (exit status 1: the laps asked for were not all driven in the time given; the log is whole)
+    subprocess.run([sim, "--max-time", "8", "--laps", "1000", "--samples", SAMPLES, "--out", replay_dir, "--quiet"],
+                   check=False, timeout=300)
+    check(os.path.exists(os.path.join(replay_dir, "log.csv")), "a recording to replay")
     port2 = free_port()
-    replay = subprocess.Popen([sim, "--replay", os.path.join(live_dir, "log.csv"), "--serve", str(port2)],
+    replay = subprocess.Popen([sim, "--replay", os.path.join(replay_dir, "log.csv"), "--serve", str(port2)],
                               stderr=subprocess.PIPE, text=True)
     try:
         wait_ready(port2, replay)
