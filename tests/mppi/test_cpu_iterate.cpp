@@ -94,25 +94,29 @@ TEST_CASE("the fused CPU iteration draws the same samples and gives the two-pass
     mppi::StepSummary sf, st;
     const auto uf = fused.step(x, &sf);
     const std::vector<float> out_f(uf.begin(), uf.end());
-    const auto ut = two_pass.step(x, &st);
     REQUIRE(sf.status == mppi::StepStatus::kOk);
-    REQUIRE(st.status == mppi::StepStatus::kOk);
-    CHECK(sf.valid_samples == st.valid_samples);
-    for (int c = 0; c < 2; ++c) CHECK(out_f[c] == Approx(ut[c]).margin(1e-5));
-    for (std::size_t i = 0; i < fused.nominal().size(); ++i)
-      CHECK(fused.nominal()[i] == Approx(two_pass.nominal()[i]).margin(1e-5));
-    CHECK(sf.effective_sample_size == Approx(st.effective_sample_size).epsilon(1e-4));
-    CHECK(sf.min_cost == Approx(st.min_cost).epsilon(1e-6));
-    CHECK(sf.mean_cost == Approx(st.mean_cost).epsilon(1e-5));
-    for (int k = 0; k < o.num_samples; ++k) REQUIRE(fused.weights()[k] == Approx(two_pass.weights()[k]).margin(1e-6));
     if (step == 0 && o.iterations == 1) {
-      // same plan in, so bit for bit the same draws and costs
+      // the same plan in (the two-pass form later sees a plan that differs by rounding, and a
+      // sample a rounding away from a cell edge of the cost map may then cost very differently)
+      const auto ut = two_pass.step(x, &st);
+      REQUIRE(st.status == mppi::StepStatus::kOk);
+      // bit for bit the same draws and costs
       const auto vf = fused.sampled_controls();
       const auto vt = two_pass.sampled_controls();
       REQUIRE(vf.size() == vt.size());
       REQUIRE(vf.size() == static_cast<std::size_t>(o.horizon) * 2 * padded);
       for (std::size_t i = 0; i < vf.size(); ++i) REQUIRE(vf[i] == vt[i]);
       for (int k = 0; k < o.num_samples; ++k) REQUIRE(fused.sampled_costs()[k] == two_pass.sampled_costs()[k]);
+      // and the same update up to rounding
+      CHECK(sf.valid_samples == st.valid_samples);
+      for (int c = 0; c < 2; ++c) CHECK(out_f[c] == Approx(ut[c]).margin(1e-6));
+      for (std::size_t i = 0; i < fused.nominal().size(); ++i)
+        CHECK(fused.nominal()[i] == Approx(two_pass.nominal()[i]).margin(1e-6));
+      CHECK(sf.effective_sample_size == Approx(st.effective_sample_size).epsilon(1e-5));
+      CHECK(sf.min_cost == st.min_cost);
+      CHECK(sf.mean_cost == Approx(st.mean_cost).epsilon(1e-6));
+      for (int k = 0; k < o.num_samples; ++k)
+        REQUIRE(fused.weights()[k] == Approx(two_pass.weights()[k]).epsilon(1e-5).margin(1e-9));
     }
     // and the update law from the fused iteration's own samples (last iteration of the step)
     const NaiveUpdate n = naive_update(fused.sampled_controls(), fused.sampled_costs(), o.num_samples,
