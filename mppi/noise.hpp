@@ -137,6 +137,37 @@ __attribute__((target("avx512f"), always_inline)) inline void philox_round16(
   p.c3 = lo0;
 }
 
+// Rounds 1 and 2 for the counters (c0 + lane, t, iteration, block): only c0 differs between
+// lanes, so round 1's product of c2 and round 2's product of c0 are the same in every lane and
+// are done once, in scalar code (the same words, fewer vector multiplies).
+__attribute__((target("avx512f"), always_inline)) inline Philox16 philox_head16(
+    __m512i c0, std::uint32_t t, std::uint32_t iteration, std::uint32_t block, std::uint32_t k0,
+    std::uint32_t k1, __m512i m0) noexcept {
+  // round 1: c0' = hi(M1 c2) ^ c1 ^ k0 and c1' = lo(M1 c2) are uniform
+  const std::uint64_t p1 = static_cast<std::uint64_t>(kPhiloxM1) * iteration;
+  const std::uint32_t c0_1 = static_cast<std::uint32_t>(p1 >> 32) ^ t ^ k0;
+  const std::uint32_t c1_1 = static_cast<std::uint32_t>(p1);
+  const __m512i even = _mm512_mul_epu32(c0, m0);
+  const __m512i odd = _mm512_mul_epu32(_mm512_shuffle_epi32(c0, _MM_PERM_DDBB), m0);
+  const __m512i hi = _mm512_mask_shuffle_epi32(odd, 0x5555, even, _MM_PERM_DDBB);
+  const __m512i c2_1 = _mm512_xor_si512(hi, _mm512_set1_epi32(static_cast<int>(block ^ k1)));
+  const __m512i c3_1 = _mm512_mullo_epi32(c0, m0);
+  // round 2: the product of c0' is uniform
+  const std::uint32_t ka = k0 + kPhiloxW0, kb = k1 + kPhiloxW1;
+  const __m512i m1 = _mm512_set1_epi32(static_cast<int>(kPhiloxM1));
+  const __m512i even1 = _mm512_mul_epu32(c2_1, m1);
+  const __m512i odd1 = _mm512_mul_epu32(_mm512_shuffle_epi32(c2_1, _MM_PERM_DDBB), m1);
+  const __m512i hi1 = _mm512_mask_shuffle_epi32(odd1, 0x5555, even1, _MM_PERM_DDBB);
+  const std::uint64_t p0 = static_cast<std::uint64_t>(kPhiloxM0) * c0_1;
+  Philox16 r;
+  r.c0 = _mm512_xor_si512(hi1, _mm512_set1_epi32(static_cast<int>(c1_1 ^ ka)));
+  r.c1 = _mm512_mullo_epi32(c2_1, m1);
+  r.c2 = _mm512_ternarylogic_epi32(c3_1, _mm512_set1_epi32(static_cast<int>(static_cast<std::uint32_t>(p0 >> 32))),
+                                   _mm512_set1_epi32(static_cast<int>(kb)), 0x96);
+  r.c3 = _mm512_set1_epi32(static_cast<int>(static_cast<std::uint32_t>(p0)));
+  return r;
+}
+
 // lanes: a multiple of 32 (two independent 16-lane streams interleaved to hide the latency).
 __attribute__((target("avx512f"))) inline void philox_words_avx512(
     std::uint32_t k0, std::uint32_t k1, std::uint32_t iteration, std::uint32_t first,
@@ -144,14 +175,13 @@ __attribute__((target("avx512f"))) inline void philox_words_avx512(
   const __m512i m0 = _mm512_set1_epi32(static_cast<int>(kPhiloxM0));
   const __m512i m1 = _mm512_set1_epi32(static_cast<int>(kPhiloxM1));
   const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-  const __m512i c1 = _mm512_set1_epi32(static_cast<int>(t));
-  const __m512i c2 = _mm512_set1_epi32(static_cast<int>(iteration));
-  const __m512i c3 = _mm512_set1_epi32(static_cast<int>(block));
   for (int v = 0; v < lanes; v += 32) {
-    Philox16 a{_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v))), lane), c1, c2, c3};
-    Philox16 b{_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v + 16))), lane), c1, c2, c3};
-    std::uint32_t ka = k0, kb = k1;
-    for (int r = 0; r < 10; ++r) {
+    Philox16 a = philox_head16(_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v))), lane),
+                               t, iteration, block, k0, k1, m0);
+    Philox16 b = philox_head16(_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v + 16))), lane),
+                               t, iteration, block, k0, k1, m0);
+    std::uint32_t ka = k0 + 2 * kPhiloxW0, kb = k1 + 2 * kPhiloxW1;
+    for (int r = 2; r < 10; ++r) {
       const __m512i bka = _mm512_set1_epi32(static_cast<int>(ka));
       const __m512i bkb = _mm512_set1_epi32(static_cast<int>(kb));
       philox_round16(a, m0, m1, bka, bkb);
@@ -178,7 +208,7 @@ __attribute__((target("avx512f"), always_inline)) inline __m512i philox_hi16(__m
 // Words 0 and 1 only (words + 0 * lanes, words + 1 * lanes; the same as philox_words_avx512's),
 // for a model with at most 2 controls, whose Box-Muller pair uses only those. The last three
 // rounds skip what cannot reach them: round 10 needs only c1, c2 of round 9; round 9 gives c1
-// and c2 from c0, c2, c3 of round 8, which needs no c1. 11% fewer vector instructions.
+// and c2 from c0, c2, c3 of round 8, which needs no c1.
 // lanes: a multiple of 32.
 __attribute__((target("avx512f"))) inline void philox_words01_avx512(
     std::uint32_t k0, std::uint32_t k1, std::uint32_t iteration, std::uint32_t first,
@@ -186,14 +216,13 @@ __attribute__((target("avx512f"))) inline void philox_words01_avx512(
   const __m512i m0 = _mm512_set1_epi32(static_cast<int>(kPhiloxM0));
   const __m512i m1 = _mm512_set1_epi32(static_cast<int>(kPhiloxM1));
   const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-  const __m512i c1 = _mm512_set1_epi32(static_cast<int>(t));
-  const __m512i c2 = _mm512_set1_epi32(static_cast<int>(iteration));
-  const __m512i c3 = _mm512_set1_epi32(static_cast<int>(block));
   for (int v = 0; v < lanes; v += 32) {
-    Philox16 a{_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v))), lane), c1, c2, c3};
-    Philox16 b{_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v + 16))), lane), c1, c2, c3};
-    std::uint32_t ka = k0, kb = k1;
-    for (int r = 0; r < 7; ++r) {
+    Philox16 a = philox_head16(_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v))), lane),
+                               t, iteration, block, k0, k1, m0);
+    Philox16 b = philox_head16(_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v + 16))), lane),
+                               t, iteration, block, k0, k1, m0);
+    std::uint32_t ka = k0 + 2 * kPhiloxW0, kb = k1 + 2 * kPhiloxW1;
+    for (int r = 2; r < 7; ++r) {
       const __m512i bka = _mm512_set1_epi32(static_cast<int>(ka));
       const __m512i bkb = _mm512_set1_epi32(static_cast<int>(kb));
       philox_round16(a, m0, m1, bka, bkb);
