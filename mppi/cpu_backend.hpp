@@ -13,6 +13,10 @@
 #include <new>
 #include <vector>
 
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#endif
+
 #include "mppi/backend.hpp"
 #include "mppi/batch.hpp"
 #include "mppi/concepts.hpp"
@@ -67,6 +71,74 @@ struct IterationArgs {
   std::uint32_t iteration;
   int num_samples, padded, horizon;
 };
+
+// partial[r] = sum_j e[j] v[r * padded + j], j in [0, kChunk), for r in [0, rows): the chunk's
+// share of the weighted sum. The portable loop reduces each row across its lanes on its own;
+// the AVX-512 one reduces 16 rows together (a transposing tree of 45 shuffles and adds instead
+// of ~8 dependent steps per row). The two may differ in the last bit (summation order); each
+// is deterministic, so results still do not depend on the thread count.
+inline void chunk_partial_sums_portable(const float* e, const float* v, std::size_t padded,
+                                        int r0, int rows, float* partial) noexcept {
+  for (int r = r0; r < rows; ++r) {
+    const float* vr = v + static_cast<std::size_t>(r) * padded;
+    float acc = 0.f;
+#pragma omp simd reduction(+ : acc)
+    for (int j = 0; j < kChunk; ++j) acc += e[j] * vr[j];
+    partial[r] = acc;
+  }
+}
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(MPPI_NO_SIMD_PHILOX)
+#define MPPI_SIMD_PARTIAL_SUMS 1
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wuninitialized"
+__attribute__((target("avx512f"))) inline void chunk_partial_sums_avx512(
+    const float* e, const float* v, std::size_t padded, int rows, float* partial) noexcept {
+  static_assert(kChunk == 64, "four 16-lane vectors per row");
+  const __m512 e0 = _mm512_loadu_ps(e), e1 = _mm512_loadu_ps(e + 16), e2 = _mm512_loadu_ps(e + 32),
+               e3 = _mm512_loadu_ps(e + 48);
+  int r0 = 0;
+  for (; r0 + 16 <= rows; r0 += 16) {
+    __m512 acc[16];
+    for (int i = 0; i < 16; ++i) {
+      const float* vr = v + static_cast<std::size_t>(r0 + i) * padded;
+      __m512 a = _mm512_mul_ps(e0, _mm512_loadu_ps(vr));
+      a = _mm512_fmadd_ps(e1, _mm512_loadu_ps(vr + 16), a);
+      a = _mm512_fmadd_ps(e2, _mm512_loadu_ps(vr + 32), a);
+      acc[i] = _mm512_fmadd_ps(e3, _mm512_loadu_ps(vr + 48), a);
+    }
+    // 16 -> 8: per 128-bit lane [a0+a2, b0+b2, a1+a3, b1+b3] for the pairs (a, b)
+    __m512 s8[8];
+    for (int k = 0; k < 8; ++k)
+      s8[k] = _mm512_add_ps(_mm512_unpacklo_ps(acc[2 * k], acc[2 * k + 1]),
+                            _mm512_unpackhi_ps(acc[2 * k], acc[2 * k + 1]));
+    // 8 -> 4: per 128-bit lane the rows 4m .. 4m + 3 in order
+    __m512 s4[4];
+    for (int m = 0; m < 4; ++m)
+      s4[m] = _mm512_add_ps(_mm512_shuffle_ps(s8[2 * m], s8[2 * m + 1], _MM_SHUFFLE(1, 0, 1, 0)),
+                            _mm512_shuffle_ps(s8[2 * m], s8[2 * m + 1], _MM_SHUFFLE(3, 2, 3, 2)));
+    // 4 -> 2 -> 1: add the 128-bit lanes, rows 4m .. 4m + 3 in 128-bit lane m
+    __m512 s2[2];
+    for (int q = 0; q < 2; ++q)
+      s2[q] = _mm512_add_ps(_mm512_shuffle_f32x4(s4[2 * q], s4[2 * q + 1], _MM_SHUFFLE(2, 0, 2, 0)),
+                            _mm512_shuffle_f32x4(s4[2 * q], s4[2 * q + 1], _MM_SHUFFLE(3, 1, 3, 1)));
+    const __m512 sum = _mm512_add_ps(_mm512_shuffle_f32x4(s2[0], s2[1], _MM_SHUFFLE(2, 0, 2, 0)),
+                                     _mm512_shuffle_f32x4(s2[0], s2[1], _MM_SHUFFLE(3, 1, 3, 1)));
+    _mm512_storeu_ps(partial + r0, sum);
+  }
+  chunk_partial_sums_portable(e, v, padded, r0, rows, partial);
+}
+#pragma GCC diagnostic pop
+#endif
+
+inline void chunk_partial_sums(const float* e, const float* v, std::size_t padded, int rows,
+                               float* partial) noexcept {
+#ifdef MPPI_SIMD_PARTIAL_SUMS
+  static const bool avx512 = __builtin_cpu_supports("avx512f");
+  if (avx512) return chunk_partial_sums_avx512(e, v, padded, rows, partial);
+#endif
+  chunk_partial_sums_portable(e, v, padded, 0, rows, partial);
+}
 
 // One chunk of samples [k0, k0 + kChunk) of a whole iteration, fused so that each time step's
 // noise and controls are used while they are in L1: per step t, draw V_t = clamp(U_t + eps)
@@ -130,13 +202,7 @@ MPPI_MULTIVERSION void iterate_chunk(const D& model, const C& cost, const Iterat
   std::copy_n(e, W, expw);
   *totals = tot;
   // partial sums of e_k V_k, read back from `controls` while the chunk is still in L1/L2
-  for (int r = 0; r < a.horizon * Nu; ++r) {
-    const float* v = controls + static_cast<std::size_t>(r) * padded + k0;
-    float acc = 0.f;
-#pragma omp simd reduction(+ : acc)
-    for (int j = 0; j < W; ++j) acc += e[j] * v[j];
-    partial[r] = acc;
-  }
+  chunk_partial_sums(e, controls + k0, padded, a.horizon * Nu, partial);
 }
 
 // The chunks' shares combined in chunk order (so independent of the thread count): weights

@@ -171,3 +171,29 @@ TEST_CASE("the fused CPU iteration gives NaN-cost samples no weight, and none va
   CHECK(sum.valid_samples == 0);
   CHECK(safe[0] == 0.f);
 }
+
+TEST_CASE("a chunk's share of the weighted sum equals a double-precision dot product", "[core][mppi]") {
+  constexpr int W = mppi::kChunk;
+  const std::size_t padded = 3 * W + 64;  // rows further apart than a chunk, as in the controls
+  for (int rows : {1, 16, 37, 200}) {
+    std::vector<float> e(W), v(static_cast<std::size_t>(rows) * padded), got(rows), portable(rows);
+    std::uint32_t h = 12345u;
+    const auto next = [&h] {  // uniform in [-1, 1)
+      h = h * 1664525u + 1013904223u;
+      return static_cast<float>(h >> 8) / 8388608.f - 1.f;
+    };
+    for (float& x : e) x = 0.5f * (next() + 1.f);
+    for (float& x : v) x = next();
+    mppi::detail::chunk_partial_sums(e.data(), v.data(), padded, rows, got.data());
+    mppi::detail::chunk_partial_sums_portable(e.data(), v.data(), padded, 0, rows, portable.data());
+    for (int r = 0; r < rows; ++r) {
+      double ref = 0, mag = 0;
+      for (int j = 0; j < W; ++j) {
+        ref += static_cast<double>(e[j]) * v[static_cast<std::size_t>(r) * padded + j];
+        mag += std::abs(static_cast<double>(e[j]) * v[static_cast<std::size_t>(r) * padded + j]);
+      }
+      REQUIRE(got[r] == Approx(ref).margin(1e-6 * mag));
+      REQUIRE(portable[r] == Approx(ref).margin(1e-6 * mag));
+    }
+  }
+}
