@@ -8,7 +8,8 @@
 //                                  the reported time is the mean (manual time).
 //   BM_PeerNoise/K/T/threads       drawing the K x T x 2 clamped perturbed controls only
 //   BM_PeerPhilox/K/T/threads      the Philox4x32-10 words of that noise only (one call per
-//                                  sample and time step: 2 controls use 2 of its 4 words)
+//                                  sample and time step: 2 controls use 2 of its 4 words, and
+//                                  only those 2 are computed to the end)
 //   BM_PeerNormals/K/T/threads     Philox + Box-Muller (the normals, not yet clamped / stored)
 //   BM_PeerRollout/K/T/threads     backend rollout with the cost (no sampling, no update)
 //   BM_PeerDynamics/K/T/threads    backend rollout, model only (cost = 0)
@@ -154,7 +155,7 @@ MPPI_MULTIVERSION float noise_stage_chunk(std::uint32_t iteration, int chunk, in
       acc += normals[t % mppi::kChunk];
     } else {
       mppi::detail::philox_words_dispatch<mppi::kChunk>(1u, 0u, iteration, static_cast<std::uint32_t>(chunk * mppi::kChunk),
-                                                        static_cast<std::uint32_t>(t), 0u, words);
+                                                        static_cast<std::uint32_t>(t), 0u, words, 2);
       acc += static_cast<float>(words[t % mppi::kChunk]);
     }
   }

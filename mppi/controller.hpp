@@ -124,7 +124,8 @@ class Controller {
     threads_ = runner_->threads();
     nominal_.assign(static_cast<std::size_t>(options_.horizon) * nu_, 0.f);
     next_.assign(nominal_.size(), 0.f);
-    controls_.assign(nominal_.size() * padded_, 0.f);
+    // the sampling pass's buffer; a backend that iterates (CPU, GPU) keeps its own
+    if (!backend_->has_iterate()) controls_.assign(nominal_.size() * padded_, 0.f);
     costs_.assign(padded_, 0.f);
     control_costs_.assign(padded_, 0.f);
     weights_.assign(padded_, 0.f);
@@ -406,6 +407,8 @@ class Controller {
             failure_reason_ += "; the fallback refused the cost map: " + why;
           switches_.push_back({step_calls_ - 1, backend_->name(), fallback->name(), failure_reason_});
           backend_ = std::move(fallback);
+          if (!backend_->has_iterate() && controls_.empty())
+            controls_.assign(nominal_.size() * padded_, 0.f);
           sum.backend_switched = true;
           sum.reason = failure_reason_.c_str();
         }

@@ -5,14 +5,25 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstddef>
 #include <cstring>
+#include <limits>
+#include <memory>
+#include <new>
 #include <vector>
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#endif
 
 #include "mppi/backend.hpp"
 #include "mppi/batch.hpp"
 #include "mppi/concepts.hpp"
 #include "mppi/error.hpp"
 #include "mppi/multiversion.hpp"
+#include "mppi/noise.hpp"
+#include "mppi/sample_step.hpp"
 #include "mppi/thread_schedule.hpp"
 
 namespace mppi {
@@ -39,6 +50,210 @@ MPPI_MULTIVERSION void rollout_chunk(const D& model, const C& cost, const float*
                                                 t, cost_out);
   }
 }
+
+// What iterate_chunk leaves for the combination of the chunks (one cache line per chunk).
+struct alignas(64) ChunkTotals {
+  float min_cost = 0.f;   // min of the chunk's finite S_k (+inf if none)
+  float eta = 0.f;        // sum_k exp(-(S_k - min_cost) / lambda) over the finite S_k
+  double cost_sum = 0.0;  // sum of the finite S_k
+  int valid = 0;          // samples with a finite S_k
+};
+
+// The parameters of one iteration, as plain pointers (see IterationInput).
+struct IterationArgs {
+  const float* x0;
+  const float* nominal;  // T x nu
+  const float* noise_std;
+  const float* lo;
+  const float* hi;
+  float gamma, inv_lambda, dt_s;
+  NoiseKey key;
+  std::uint32_t iteration;
+  int num_samples, padded, horizon;
+};
+
+// partial[r] = sum_j e[j] v[r * padded + j], j in [0, kChunk), for r in [0, rows): the chunk's
+// share of the weighted sum. The portable loop reduces each row across its lanes on its own;
+// the AVX-512 one reduces 16 rows together (a transposing tree of 45 shuffles and adds instead
+// of ~8 dependent steps per row). The two may differ in the last bit (summation order); each
+// is deterministic, so results still do not depend on the thread count.
+inline void chunk_partial_sums_portable(const float* e, const float* v, std::size_t padded,
+                                        int r0, int rows, float* partial) noexcept {
+  for (int r = r0; r < rows; ++r) {
+    const float* vr = v + static_cast<std::size_t>(r) * padded;
+    float acc = 0.f;
+#pragma omp simd reduction(+ : acc)
+    for (int j = 0; j < kChunk; ++j) acc += e[j] * vr[j];
+    partial[r] = acc;
+  }
+}
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(MPPI_NO_SIMD_PHILOX)
+#define MPPI_SIMD_PARTIAL_SUMS 1
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wuninitialized"
+__attribute__((target("avx512f"))) inline void chunk_partial_sums_avx512(
+    const float* e, const float* v, std::size_t padded, int rows, float* partial) noexcept {
+  static_assert(kChunk == 64, "four 16-lane vectors per row");
+  const __m512 e0 = _mm512_loadu_ps(e), e1 = _mm512_loadu_ps(e + 16), e2 = _mm512_loadu_ps(e + 32),
+               e3 = _mm512_loadu_ps(e + 48);
+  int r0 = 0;
+  for (; r0 + 16 <= rows; r0 += 16) {
+    __m512 acc[16];
+    for (int i = 0; i < 16; ++i) {
+      const float* vr = v + static_cast<std::size_t>(r0 + i) * padded;
+      __m512 a = _mm512_mul_ps(e0, _mm512_loadu_ps(vr));
+      a = _mm512_fmadd_ps(e1, _mm512_loadu_ps(vr + 16), a);
+      a = _mm512_fmadd_ps(e2, _mm512_loadu_ps(vr + 32), a);
+      acc[i] = _mm512_fmadd_ps(e3, _mm512_loadu_ps(vr + 48), a);
+    }
+    // 16 -> 8: per 128-bit lane [a0+a2, b0+b2, a1+a3, b1+b3] for the pairs (a, b)
+    __m512 s8[8];
+    for (int k = 0; k < 8; ++k)
+      s8[k] = _mm512_add_ps(_mm512_unpacklo_ps(acc[2 * k], acc[2 * k + 1]),
+                            _mm512_unpackhi_ps(acc[2 * k], acc[2 * k + 1]));
+    // 8 -> 4: per 128-bit lane the rows 4m .. 4m + 3 in order
+    __m512 s4[4];
+    for (int m = 0; m < 4; ++m)
+      s4[m] = _mm512_add_ps(_mm512_shuffle_ps(s8[2 * m], s8[2 * m + 1], _MM_SHUFFLE(1, 0, 1, 0)),
+                            _mm512_shuffle_ps(s8[2 * m], s8[2 * m + 1], _MM_SHUFFLE(3, 2, 3, 2)));
+    // 4 -> 2 -> 1: add the 128-bit lanes, rows 4m .. 4m + 3 in 128-bit lane m
+    __m512 s2[2];
+    for (int q = 0; q < 2; ++q)
+      s2[q] = _mm512_add_ps(_mm512_shuffle_f32x4(s4[2 * q], s4[2 * q + 1], _MM_SHUFFLE(2, 0, 2, 0)),
+                            _mm512_shuffle_f32x4(s4[2 * q], s4[2 * q + 1], _MM_SHUFFLE(3, 1, 3, 1)));
+    const __m512 sum = _mm512_add_ps(_mm512_shuffle_f32x4(s2[0], s2[1], _MM_SHUFFLE(2, 0, 2, 0)),
+                                     _mm512_shuffle_f32x4(s2[0], s2[1], _MM_SHUFFLE(3, 1, 3, 1)));
+    _mm512_storeu_ps(partial + r0, sum);
+  }
+  chunk_partial_sums_portable(e, v, padded, r0, rows, partial);
+}
+#pragma GCC diagnostic pop
+#endif
+
+inline void chunk_partial_sums(const float* e, const float* v, std::size_t padded, int rows,
+                               float* partial) noexcept {
+#ifdef MPPI_SIMD_PARTIAL_SUMS
+  static const bool avx512 = __builtin_cpu_supports("avx512f");
+  if (avx512) return chunk_partial_sums_avx512(e, v, padded, rows, partial);
+#endif
+  chunk_partial_sums_portable(e, v, padded, 0, rows, partial);
+}
+
+// One chunk of samples [k0, k0 + kChunk) of a whole iteration, fused so that each time step's
+// noise and controls are used while they are in L1: per step t, draw V_t = clamp(U_t + eps)
+// (sample_step_block, the numbers of Controller's sampling pass), store it into `controls`
+// (T x nu x padded, kept for the caller) and step the model and cost with it. Then the chunk's
+// share of the update with weights relative to the chunk's own minimum:
+//   e_k = exp(-(S_k - m_c) / lambda),  partial[t * nu + c] = sum_k e_k V_k,t,c
+// (the caller rescales by exp(-(m_c - min S) / lambda): the same weights as the two-pass form,
+// up to rounding). costs, expw: the chunk's S_k and e_k (k - k0 in [0, kChunk)).
+// work: D::kNx*kChunk + D::kNu*kChunk + model scratch floats.
+template <class D, class C>
+MPPI_MULTIVERSION void iterate_chunk(const D& model, const C& cost, const IterationArgs& a,
+                                     int k0, float* work, float* controls, float* costs,
+                                     float* expw, float* partial, ChunkTotals* totals) noexcept {
+  constexpr int W = kChunk;
+  constexpr int Nu = D::kNu;
+  float* x = work;            // kNx x W
+  float* u = x + D::kNx * W;  // kNu x W
+  float* scratch = u + Nu * W;
+  alignas(64) float state_cost[W] = {};
+  alignas(64) float control_cost[W] = {};
+  for (int i = 0; i < D::kNx; ++i) std::fill_n(x + i * W, W, a.x0[i]);
+  const float valid_lanes = static_cast<float>(a.num_samples - k0);
+  const std::size_t padded = static_cast<std::size_t>(a.padded);
+  for (int t = 0; t < a.horizon; ++t) {
+    for (int c0 = 0; c0 < Nu; c0 += 4)
+      sample_step_block<W>(a.key, a.iteration, k0, valid_lanes, t, c0, std::min(4, Nu - c0),
+                           a.nominal + t * Nu, a.noise_std, a.lo, a.hi, a.gamma, u + c0 * W,
+                           control_cost);
+    for (int c = 0; c < Nu; ++c)
+      std::memcpy(controls + (static_cast<std::size_t>(t) * Nu + c) * padded + k0, u + c * W,
+                  sizeof(float) * W);
+    model.template step<W>(Batch<D::kNx, W>{x}, ConstBatch<Nu, W>{u}, a.dt_s, scratch);
+    cost.template accumulate<D::kNx, Nu, W>(ConstBatch<D::kNx, W>{x}, ConstBatch<Nu, W>{u}, t,
+                                            state_cost);
+  }
+  // S_k (the same sum as Controller's two-pass update: rollout cost + control cost)
+  alignas(64) float s[W];
+  float m = std::numeric_limits<float>::infinity();
+  MPPI_SIMD_LOOP
+  for (int j = 0; j < W; ++j) {
+    s[j] = state_cost[j] + control_cost[j];
+    const bool use = static_cast<float>(j) < valid_lanes && std::isfinite(s[j]);
+    m = std::min(m, use ? s[j] : std::numeric_limits<float>::infinity());
+  }
+  std::copy_n(s, W, costs);
+  ChunkTotals tot;
+  tot.min_cost = m;
+  alignas(64) float e[W];
+  float eta = 0.f;
+  for (int j = 0; j < W; ++j) {
+    const bool use = static_cast<float>(j) < valid_lanes && std::isfinite(s[j]);
+    e[j] = use ? std::exp(-(s[j] - m) * a.inv_lambda) : 0.f;
+    eta += e[j];
+    if (use) {
+      tot.cost_sum += s[j];
+      ++tot.valid;
+    }
+  }
+  tot.eta = eta;
+  std::copy_n(e, W, expw);
+  *totals = tot;
+  // partial sums of e_k V_k, read back from `controls` while the chunk is still in L1/L2
+  chunk_partial_sums(e, controls + k0, padded, a.horizon * Nu, partial);
+}
+
+// The chunks' shares combined in chunk order (so independent of the thread count): weights
+// w_k = e_k exp(-(m_c - m) / lambda) / eta, next = sum_c exp(-(m_c - m) / lambda) partial_c / eta,
+// accumulated in double. rows = T * nu; partial_stride: floats between two chunks' partials;
+// sums: rows doubles and scales: chunks doubles of scratch.
+MPPI_MULTIVERSION inline void combine_chunks(const ChunkTotals* totals, const float* partial,
+                                             std::size_t partial_stride, int chunks, int rows,
+                                             int num_samples, float inv_lambda, const float* expw,
+                                             double* sums, double* scales,
+                                             IterationOutput& out) noexcept {
+  float m = std::numeric_limits<float>::infinity();
+  int valid = 0;
+  double cost_sum = 0.0;
+  for (int c = 0; c < chunks; ++c) {
+    m = std::min(m, totals[c].min_cost);
+    valid += totals[c].valid;
+    cost_sum += totals[c].cost_sum;
+  }
+  out.valid_samples = valid;
+  if (valid == 0) {
+    std::fill(out.weights.begin(), out.weights.end(), 0.f);
+    return;
+  }
+  std::fill_n(sums, rows, 0.0);
+  double eta = 0.0;
+  for (int c = 0; c < chunks; ++c) {
+    scales[c] = totals[c].valid == 0 ? 0.0 : std::exp(-static_cast<double>(totals[c].min_cost - m) * inv_lambda);
+    if (totals[c].valid == 0) continue;
+    const double scale = scales[c];
+    eta += scale * totals[c].eta;
+    const float* p = partial + static_cast<std::size_t>(c) * partial_stride;
+    MPPI_SIMD_LOOP
+    for (int r = 0; r < rows; ++r) sums[r] += scale * p[r];
+  }
+  const double inv_eta = 1.0 / eta;  // eta >= 1: the best sample has e = 1 and scale = 1
+  for (int r = 0; r < rows; ++r) out.next[r] = static_cast<float>(sums[r] * inv_eta);
+  double sum_sq = 0.0;
+  for (int c = 0; c < chunks; ++c) {
+    const auto f = static_cast<float>(scales[c] * inv_eta);
+    const int k_end = std::min(num_samples, (c + 1) * kChunk);
+    float* w = out.weights.data();
+    for (int k = c * kChunk; k < k_end; ++k) {
+      w[k] = expw[k] * f;
+      sum_sq += static_cast<double>(w[k]) * w[k];
+    }
+  }
+  out.min_cost = m;
+  out.mean_cost = static_cast<float>(cost_sum / valid);
+  out.sum_sq_weights = static_cast<float>(sum_sq);
+}
 }  // namespace detail
 
 inline int padded_sample_count(int num_samples) {
@@ -59,6 +274,15 @@ class CpuBackend final : public Backend {
     // Round each thread's slice to a cache line (16 floats) so threads never share one.
     work_floats_ = (work_floats_ + 15) / 16 * 16;
     work_.assign(work_floats_ * static_cast<std::size_t>(threads_), 0.f);
+    const int chunks = shape_.padded_samples / kChunk;
+    const std::size_t rows = static_cast<std::size_t>(horizon) * D::kNu;
+    controls_ = aligned_floats(rows * static_cast<std::size_t>(shape_.padded_samples));
+    expw_ = aligned_floats(static_cast<std::size_t>(shape_.padded_samples));
+    partial_stride_ = (rows + 15) / 16 * 16;  // a whole number of cache lines per chunk
+    partial_ = aligned_floats(partial_stride_ * static_cast<std::size_t>(chunks));
+    totals_.assign(static_cast<std::size_t>(chunks), detail::ChunkTotals{});
+    sums_.assign(rows, 0.0);
+    scales_.assign(static_cast<std::size_t>(chunks), 0.0);
   }
 
   const char* name() const override { return "cpu"; }
@@ -74,6 +298,39 @@ class CpuBackend final : public Backend {
   bool set_cost_map(std::shared_ptr<const CostMap> map, std::string* why) override {
     if constexpr (requires { cost_.set_map(map, why); }) return cost_.set_map(std::move(map), why);
     else return Backend::set_cost_map(std::move(map), why);
+  }
+
+  // The whole iteration in one parallel pass over the chunks (detail::iterate_chunk), then
+  // the chunks combined in order (detail::combine_chunks).
+  bool has_iterate() const override { return true; }
+  void iterate(const IterationInput& in, IterationOutput& out) override {
+    const int padded = shape_.padded_samples;
+    const int chunks = padded / kChunk;
+    const detail::IterationArgs args{in.x0.data(), in.nominal.data(), in.noise_std.data(),
+                                     in.control_min.data(), in.control_max.data(), in.gamma,
+                                     1.f / in.lambda, dt_s_, NoiseKey{in.seed}, in.iteration,
+                                     shape_.num_samples, padded, shape_.horizon};
+    float* work = work_.data();
+    const std::size_t work_floats = work_floats_;
+    float* controls = controls_.get();
+    float* costs = out.costs.data();
+    float* expw = expw_.get();
+    float* partial = partial_.get();
+    const std::size_t stride = partial_stride_;
+    detail::ChunkTotals* totals = totals_.data();
+    runner_.run(chunks, 1, [&](int chunk, int slot) {
+      const int k0 = chunk * kChunk;
+      detail::iterate_chunk(model_, cost_, args, k0,
+                            work + work_floats * static_cast<std::size_t>(slot), controls,
+                            costs + k0, expw + k0, partial + stride * static_cast<std::size_t>(chunk),
+                            totals + chunk);
+    });
+    detail::combine_chunks(totals, partial, stride, chunks, shape_.horizon * D::kNu,
+                           shape_.num_samples, 1.f / in.lambda, expw, sums_.data(), scales_.data(), out);
+  }
+  std::span<const float> sampled_controls() const override {
+    return {controls_.get(), static_cast<std::size_t>(shape_.horizon) * D::kNu *
+                                 static_cast<std::size_t>(shape_.padded_samples)};
   }
 
   void rollout(std::span<const float> x0, std::span<const float> controls,
@@ -92,6 +349,18 @@ class CpuBackend final : public Backend {
   }
 
  private:
+  struct AlignedFree {
+    void operator()(float* p) const noexcept { ::operator delete[](p, std::align_val_t{64}); }
+  };
+  using AlignedFloats = std::unique_ptr<float[], AlignedFree>;
+  // n zeroed floats on a cache-line boundary (so that chunks written by different threads
+  // never share a line).
+  static AlignedFloats aligned_floats(std::size_t n) {
+    AlignedFloats p(static_cast<float*>(::operator new[](n * sizeof(float), std::align_val_t{64})));
+    std::fill_n(p.get(), n, 0.f);
+    return p;
+  }
+
   D model_;
   C cost_;
   float dt_s_;
@@ -100,6 +369,12 @@ class CpuBackend final : public Backend {
   int threads_ = 1;
   std::size_t work_floats_ = 0;
   std::vector<float> work_;  // threads x work_floats_
+  // iterate(): the sampled controls (T x nu x padded), e_k per sample, each chunk's partial sums
+  // (partial_stride_ floats per chunk) and totals, and the combination's scratch
+  AlignedFloats controls_, expw_, partial_;
+  std::size_t partial_stride_ = 0;
+  std::vector<detail::ChunkTotals> totals_;
+  std::vector<double> sums_, scales_;
 };
 
 }  // namespace mppi

@@ -7,6 +7,7 @@
 // against Random123's own philox4x32 and the normal distribution. On x86-64 the Philox words
 // come from AVX-512 / AVX2 code when the CPU has it (the very same words, see
 // detail::philox_words_dispatch).
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -54,13 +55,33 @@ inline void philox4x32_10(std::uint32_t c[4], std::uint32_t k0, std::uint32_t k1
   philox4x32_10(c[0], c[1], c[2], c[3], k0, k1);
 }
 
+namespace detail {
+// sin and cos of 2 pi u, u in [0, 1): fast_sincos_turns's reduction and polynomials, so the
+// same numbers (tests compare all 2^24 values Box-Muller passes), with the quarter-turn rotation
+// done by integer bit operations (a swap mask and sign flips) instead of chained selects: fewer
+// vector instructions per lane.
+inline void sincos_turns(float u, float* sin_out, float* cos_out) noexcept {
+  const float q = static_cast<float>(static_cast<int>(u * 4.f + 0.5f));
+  const float r = (u - 0.25f * q) * 6.28318530718f;
+  const float r2 = r * r;
+  const float s = r * (1.f + r2 * (-1.f / 6 + r2 * (1.f / 120 + r2 * (-1.f / 5040 + r2 * (1.f / 362880)))));
+  const float c = 1.f + r2 * (-0.5f + r2 * (1.f / 24 + r2 * (-1.f / 720 + r2 * (1.f / 40320))));
+  // q = 0: (sin, cos) = (s, c); 1: (c, -s); 2: (-s, -c); 3: (-c, s)
+  const auto qi = static_cast<std::uint32_t>(static_cast<int>(q));
+  const std::uint32_t swap = 0u - (qi & 1u);  // all ones when q is odd
+  const std::uint32_t bs = std::bit_cast<std::uint32_t>(s), bc = std::bit_cast<std::uint32_t>(c);
+  *sin_out = std::bit_cast<float>(((bs & ~swap) | (bc & swap)) ^ ((qi & 2u) << 30));
+  *cos_out = std::bit_cast<float>(((bc & ~swap) | (bs & swap)) ^ (((qi + 1u) & 2u) << 30));
+}
+}  // namespace detail
+
 // Two standard normals from two random words (Box-Muller). u1 in (0, 1) so log is finite.
 inline void box_muller(std::uint32_t a, std::uint32_t b, float* n0, float* n1) noexcept {
   const float u1 = (static_cast<float>(a >> 8) + 0.5f) * (1.f / 16777216.f);
   const float u2 = static_cast<float>(b >> 8) * (1.f / 16777216.f);
   const float r = std::sqrt(-2.f * fast_log(u1));
   float s, c;
-  fast_sincos_turns(u2, &s, &c);
+  detail::sincos_turns(u2, &s, &c);
   *n0 = r * c;
   *n1 = r * s;
 }
@@ -116,6 +137,37 @@ __attribute__((target("avx512f"), always_inline)) inline void philox_round16(
   p.c3 = lo0;
 }
 
+// Rounds 1 and 2 for the counters (c0 + lane, t, iteration, block): only c0 differs between
+// lanes, so round 1's product of c2 and round 2's product of c0 are the same in every lane and
+// are done once, in scalar code (the same words, fewer vector multiplies).
+__attribute__((target("avx512f"), always_inline)) inline Philox16 philox_head16(
+    __m512i c0, std::uint32_t t, std::uint32_t iteration, std::uint32_t block, std::uint32_t k0,
+    std::uint32_t k1, __m512i m0) noexcept {
+  // round 1: c0' = hi(M1 c2) ^ c1 ^ k0 and c1' = lo(M1 c2) are uniform
+  const std::uint64_t p1 = static_cast<std::uint64_t>(kPhiloxM1) * iteration;
+  const std::uint32_t c0_1 = static_cast<std::uint32_t>(p1 >> 32) ^ t ^ k0;
+  const std::uint32_t c1_1 = static_cast<std::uint32_t>(p1);
+  const __m512i even = _mm512_mul_epu32(c0, m0);
+  const __m512i odd = _mm512_mul_epu32(_mm512_shuffle_epi32(c0, _MM_PERM_DDBB), m0);
+  const __m512i hi = _mm512_mask_shuffle_epi32(odd, 0x5555, even, _MM_PERM_DDBB);
+  const __m512i c2_1 = _mm512_xor_si512(hi, _mm512_set1_epi32(static_cast<int>(block ^ k1)));
+  const __m512i c3_1 = _mm512_mullo_epi32(c0, m0);
+  // round 2: the product of c0' is uniform
+  const std::uint32_t ka = k0 + kPhiloxW0, kb = k1 + kPhiloxW1;
+  const __m512i m1 = _mm512_set1_epi32(static_cast<int>(kPhiloxM1));
+  const __m512i even1 = _mm512_mul_epu32(c2_1, m1);
+  const __m512i odd1 = _mm512_mul_epu32(_mm512_shuffle_epi32(c2_1, _MM_PERM_DDBB), m1);
+  const __m512i hi1 = _mm512_mask_shuffle_epi32(odd1, 0x5555, even1, _MM_PERM_DDBB);
+  const std::uint64_t p0 = static_cast<std::uint64_t>(kPhiloxM0) * c0_1;
+  Philox16 r;
+  r.c0 = _mm512_xor_si512(hi1, _mm512_set1_epi32(static_cast<int>(c1_1 ^ ka)));
+  r.c1 = _mm512_mullo_epi32(c2_1, m1);
+  r.c2 = _mm512_ternarylogic_epi32(c3_1, _mm512_set1_epi32(static_cast<int>(static_cast<std::uint32_t>(p0 >> 32))),
+                                   _mm512_set1_epi32(static_cast<int>(kb)), 0x96);
+  r.c3 = _mm512_set1_epi32(static_cast<int>(static_cast<std::uint32_t>(p0)));
+  return r;
+}
+
 // lanes: a multiple of 32 (two independent 16-lane streams interleaved to hide the latency).
 __attribute__((target("avx512f"))) inline void philox_words_avx512(
     std::uint32_t k0, std::uint32_t k1, std::uint32_t iteration, std::uint32_t first,
@@ -123,14 +175,13 @@ __attribute__((target("avx512f"))) inline void philox_words_avx512(
   const __m512i m0 = _mm512_set1_epi32(static_cast<int>(kPhiloxM0));
   const __m512i m1 = _mm512_set1_epi32(static_cast<int>(kPhiloxM1));
   const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-  const __m512i c1 = _mm512_set1_epi32(static_cast<int>(t));
-  const __m512i c2 = _mm512_set1_epi32(static_cast<int>(iteration));
-  const __m512i c3 = _mm512_set1_epi32(static_cast<int>(block));
   for (int v = 0; v < lanes; v += 32) {
-    Philox16 a{_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v))), lane), c1, c2, c3};
-    Philox16 b{_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v + 16))), lane), c1, c2, c3};
-    std::uint32_t ka = k0, kb = k1;
-    for (int r = 0; r < 10; ++r) {
+    Philox16 a = philox_head16(_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v))), lane),
+                               t, iteration, block, k0, k1, m0);
+    Philox16 b = philox_head16(_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v + 16))), lane),
+                               t, iteration, block, k0, k1, m0);
+    std::uint32_t ka = k0 + 2 * kPhiloxW0, kb = k1 + 2 * kPhiloxW1;
+    for (int r = 2; r < 10; ++r) {
       const __m512i bka = _mm512_set1_epi32(static_cast<int>(ka));
       const __m512i bkb = _mm512_set1_epi32(static_cast<int>(kb));
       philox_round16(a, m0, m1, bka, bkb);
@@ -144,6 +195,61 @@ __attribute__((target("avx512f"))) inline void philox_words_avx512(
       _mm512_storeu_si512(words + 2 * lanes + off, p.c2);
       _mm512_storeu_si512(words + 3 * lanes + off, p.c3);
     }
+  }
+}
+
+// The high words of c * m on 16 lanes (as in philox_round16).
+__attribute__((target("avx512f"), always_inline)) inline __m512i philox_hi16(__m512i c, __m512i m) noexcept {
+  const __m512i even = _mm512_mul_epu32(c, m);
+  const __m512i odd = _mm512_mul_epu32(_mm512_shuffle_epi32(c, _MM_PERM_DDBB), m);
+  return _mm512_mask_shuffle_epi32(odd, 0x5555, even, _MM_PERM_DDBB);
+}
+
+// Words 0 and 1 only (words + 0 * lanes, words + 1 * lanes; the same as philox_words_avx512's),
+// for a model with at most 2 controls, whose Box-Muller pair uses only those. The last three
+// rounds skip what cannot reach them: round 10 needs only c1, c2 of round 9; round 9 gives c1
+// and c2 from c0, c2, c3 of round 8, which needs no c1.
+// lanes: a multiple of 32.
+__attribute__((target("avx512f"))) inline void philox_words01_avx512(
+    std::uint32_t k0, std::uint32_t k1, std::uint32_t iteration, std::uint32_t first,
+    std::uint32_t t, std::uint32_t block, int lanes, std::uint32_t* words) noexcept {
+  const __m512i m0 = _mm512_set1_epi32(static_cast<int>(kPhiloxM0));
+  const __m512i m1 = _mm512_set1_epi32(static_cast<int>(kPhiloxM1));
+  const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  for (int v = 0; v < lanes; v += 32) {
+    Philox16 a = philox_head16(_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v))), lane),
+                               t, iteration, block, k0, k1, m0);
+    Philox16 b = philox_head16(_mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first + static_cast<std::uint32_t>(v + 16))), lane),
+                               t, iteration, block, k0, k1, m0);
+    std::uint32_t ka = k0 + 2 * kPhiloxW0, kb = k1 + 2 * kPhiloxW1;
+    for (int r = 2; r < 7; ++r) {
+      const __m512i bka = _mm512_set1_epi32(static_cast<int>(ka));
+      const __m512i bkb = _mm512_set1_epi32(static_cast<int>(kb));
+      philox_round16(a, m0, m1, bka, bkb);
+      philox_round16(b, m0, m1, bka, bkb);
+      ka += kPhiloxW0;
+      kb += kPhiloxW1;
+    }
+    const __m512i ka8 = _mm512_set1_epi32(static_cast<int>(ka));
+    const __m512i kb8 = _mm512_set1_epi32(static_cast<int>(kb));
+    const __m512i kb9 = _mm512_set1_epi32(static_cast<int>(kb + kPhiloxW1));
+    const __m512i ka10 = _mm512_set1_epi32(static_cast<int>(ka + 2 * kPhiloxW0));
+    for (Philox16* p : {&a, &b}) {
+      // round 8: c0, c2, c3
+      const __m512i c0_8 = _mm512_ternarylogic_epi32(philox_hi16(p->c2, m1), p->c1, ka8, 0x96);
+      const __m512i c2_8 = _mm512_ternarylogic_epi32(philox_hi16(p->c0, m0), p->c3, kb8, 0x96);
+      const __m512i c3_8 = _mm512_mullo_epi32(p->c0, m0);
+      // round 9: c1, c2
+      const __m512i c1_9 = _mm512_mullo_epi32(c2_8, m1);
+      const __m512i c2_9 = _mm512_ternarylogic_epi32(philox_hi16(c0_8, m0), c3_8, kb9, 0x96);
+      // round 10: c0, c1
+      p->c0 = _mm512_ternarylogic_epi32(philox_hi16(c2_9, m1), c1_9, ka10, 0x96);
+      p->c1 = _mm512_mullo_epi32(c2_9, m1);
+    }
+    _mm512_storeu_si512(words + 0 * lanes + v, a.c0);
+    _mm512_storeu_si512(words + 1 * lanes + v, a.c1);
+    _mm512_storeu_si512(words + 0 * lanes + v + 16, b.c0);
+    _mm512_storeu_si512(words + 1 * lanes + v + 16, b.c1);
   }
 }
 
@@ -189,15 +295,20 @@ inline int philox_simd_level() noexcept {
 #pragma GCC diagnostic pop
 #endif
 
-// philox_words<W> on the fastest path this CPU has.
+// philox_words<W> on the fastest path this CPU has. words_needed = 2: only words 0 and 1 are
+// needed (the others may be left unwritten).
 template <int W>
 inline void philox_words_dispatch(std::uint32_t k0, std::uint32_t k1, std::uint32_t iteration,
                                   std::uint32_t first, std::uint32_t t, std::uint32_t block,
-                                  std::uint32_t* words) noexcept {
+                                  std::uint32_t* words, int words_needed = 4) noexcept {
+  (void)words_needed;
 #ifdef MPPI_SIMD_PHILOX
   if constexpr (W % 8 == 0) {
     const int level = philox_simd_level();
-    if (W % 32 == 0 && level == 2) return philox_words_avx512(k0, k1, iteration, first, t, block, W, words);
+    if (W % 32 == 0 && level == 2) {
+      if (words_needed <= 2) return philox_words01_avx512(k0, k1, iteration, first, t, block, W, words);
+      return philox_words_avx512(k0, k1, iteration, first, t, block, W, words);
+    }
     if (level >= 1) return philox_words_avx2(k0, k1, iteration, first, t, block, W, words);
   }
 #endif
@@ -215,7 +326,7 @@ inline void normal_block(const NoiseKey& key, std::uint32_t iteration, std::uint
   alignas(64) std::uint32_t words[4 * W];
   detail::philox_words_dispatch<W>(static_cast<std::uint32_t>(key.seed),
                                    static_cast<std::uint32_t>(key.seed >> 32), iteration,
-                                   first_sample, t, block, words);
+                                   first_sample, t, block, words, 2 * pairs);
   MPPI_SIMD_LOOP
   for (int j = 0; j < W; ++j) box_muller(words[j], words[W + j], &out[0 * W + j], &out[1 * W + j]);
   if (pairs > 1) {

@@ -3,7 +3,9 @@
 // Box-Muller pair gives the same first two channels as the scalar reference.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -28,7 +30,33 @@ TEST_CASE("SIMD Philox words equal the portable ones", "[noise]") {
 #endif
     mppi::detail::philox_words_dispatch<W>(k0, k1, it, first, t, block, got.data());
     CHECK(got == ref);
+    // words 0 and 1 only (a model with <= 2 controls)
+    const std::vector<std::uint32_t> ref01(ref.begin(), ref.begin() + 2 * W);
+#ifdef MPPI_SIMD_PHILOX
+    if (__builtin_cpu_supports("avx512f")) {
+      std::fill(got.begin(), got.end(), 0u);
+      mppi::detail::philox_words01_avx512(k0, k1, it, first, t, block, W, got.data());
+      CHECK(std::vector<std::uint32_t>(got.begin(), got.begin() + 2 * W) == ref01);
+    }
+#endif
+    std::fill(got.begin(), got.end(), 0u);
+    mppi::detail::philox_words_dispatch<W>(k0, k1, it, first, t, block, got.data(), 2);
+    CHECK(std::vector<std::uint32_t>(got.begin(), got.begin() + 2 * W) == ref01);
   }
+}
+
+TEST_CASE("Box-Muller's sin and cos equal fast_sincos_turns on every value it passes", "[noise]") {
+  // u2 = (word >> 8) / 2^24: all 2^24 values, bit for bit
+  int differ = 0;
+  for (std::uint32_t b = 0; b < (1u << 24); ++b) {
+    const float u = static_cast<float>(b) * (1.f / 16777216.f);
+    float s0, c0, s1, c1;
+    mppi::fast_sincos_turns(u, &s0, &c0);
+    mppi::detail::sincos_turns(u, &s1, &c1);
+    differ += std::bit_cast<std::uint32_t>(s0) != std::bit_cast<std::uint32_t>(s1) ||
+              std::bit_cast<std::uint32_t>(c0) != std::bit_cast<std::uint32_t>(c1);
+  }
+  CHECK(differ == 0);
 }
 
 TEST_CASE("normal_block with one pair gives channels 0 and 1 of the reference", "[noise]") {
