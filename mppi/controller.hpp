@@ -61,29 +61,14 @@ MPPI_MULTIVERSION inline void sample_chunk(const NoiseKey& key, std::uint32_t it
                                            const float* lo, const float* hi, float gamma,
                                            float* controls, float* control_cost) noexcept {
   constexpr int W = kChunk;
-  float normals[4 * W];
-  float acc[W] = {};
+  alignas(64) float acc[W] = {};
   const float valid_lanes = static_cast<float>(num_samples - k0);  // lanes j >= this get no noise
-  for (int t = 0; t < horizon; ++t) {
-    for (int block = 0; block * 4 < nu; ++block) {
-      normal_block<W>(key, iteration, static_cast<std::uint32_t>(k0), static_cast<std::uint32_t>(t),
-                      static_cast<std::uint32_t>(block), normals, nu - block * 4 > 2 ? 2 : 1);
-      for (int c = block * 4; c < std::min(nu, block * 4 + 4); ++c) {
-        const float u = nominal[t * nu + c];
-        const float sd = noise_std[c];
-        const float inv_var = 1.f / (sd * sd);
-        const float* n = normals + (c - block * 4) * W;
-        float* v = controls + (static_cast<std::size_t>(t) * nu + c) * padded + k0;
-        MPPI_SIMD_LOOP
-        for (int j = 0; j < W; ++j) {
-          const float on = static_cast<float>(j) < valid_lanes ? 1.f : 0.f;
-          const float vj = clampf(u + on * sd * n[j], lo[c], hi[c]);
-          v[j] = vj;
-          acc[j] += gamma * u * inv_var * (vj - u);
-        }
-      }
-    }
-  }
+  const auto stride = static_cast<std::size_t>(padded);
+  for (int t = 0; t < horizon; ++t)
+    for (int c0 = 0; c0 < nu; c0 += 4)
+      sample_step_block<W>(key, iteration, k0, valid_lanes, t, c0, std::min(4, nu - c0), nominal + t * nu,
+                           noise_std, lo, hi, gamma, controls + (static_cast<std::size_t>(t) * nu + c0) * stride + k0,
+                           stride, acc);
   std::copy_n(acc, W, control_cost + k0);
 }
 }  // namespace detail

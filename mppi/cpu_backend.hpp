@@ -166,7 +166,7 @@ MPPI_MULTIVERSION void iterate_chunk(const D& model, const C& cost, const Iterat
   for (int t = 0; t < a.horizon; ++t) {
     for (int c0 = 0; c0 < Nu; c0 += 4)
       sample_step_block<W>(a.key, a.iteration, k0, valid_lanes, t, c0, std::min(4, Nu - c0),
-                           a.nominal + t * Nu, a.noise_std, a.lo, a.hi, a.gamma, u + c0 * W,
+                           a.nominal + t * Nu, a.noise_std, a.lo, a.hi, a.gamma, u + c0 * W, W,
                            control_cost);
     for (int c = 0; c < Nu; ++c)
       std::memcpy(controls + (static_cast<std::size_t>(t) * Nu + c) * padded + k0, u + c * W,
