@@ -36,6 +36,7 @@ sanitizer_build() {  # <dir> <target> <flags>
 # Runs mppi-tests in two processes (one per core), split by tags.
 run_asan() {
   export ASAN_OPTIONS="detect_leaks=1:halt_on_error=1:detect_stack_use_after_return=0:strict_string_checks=1"
+  export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0"
   export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
   local t0=$SECONDS bin=build-asan/bin/mppi-tests
   local first="[sysid],[diagnose]"
