@@ -141,36 +141,40 @@ inline void chunk_partial_sums(const float* e, const float* v, std::size_t padde
 }
 
 // One chunk of samples [k0, k0 + kChunk) of a whole iteration, fused so that each time step's
-// noise and controls are used while they are in L1: per step t, draw V_t = clamp(U_t + eps)
-// (sample_step_block, the numbers of Controller's sampling pass), store it into `controls`
-// (T x nu x padded, kept for the caller) and step the model and cost with it. Then the chunk's
-// share of the update with weights relative to the chunk's own minimum:
+// noise and controls are used while they are in L1: per pair of steps t, t + 1 draw
+// V = clamp(U + eps) for both (sample_step_pair, the numbers of Controller's sampling pass; one
+// Philox call per lane and channel pair serves both steps), store them into `controls`
+// (T x nu x padded, kept for the caller), then step the model and cost with each. Then the
+// chunk's share of the update with weights relative to the chunk's own minimum:
 //   e_k = exp(-(S_k - m_c) / lambda),  partial[t * nu + c] = sum_k e_k V_k,t,c
 // (the caller rescales by exp(-(m_c - min S) / lambda): the same weights as the two-pass form,
 // up to rounding). costs, expw: the chunk's S_k and e_k (k - k0 in [0, kChunk)).
-// work: D::kNx*kChunk + D::kNu*kChunk + model scratch floats.
+// work: D::kNx*kChunk + 2*D::kNu*kChunk + model scratch floats.
 template <class D, class C>
 MPPI_MULTIVERSION void iterate_chunk(const D& model, const C& cost, const IterationArgs& a,
                                      int k0, float* work, float* controls, float* costs,
                                      float* expw, float* partial, ChunkTotals* totals) noexcept {
   constexpr int W = kChunk;
   constexpr int Nu = D::kNu;
-  float* x = work;            // kNx x W
-  float* u = x + D::kNx * W;  // kNu x W
-  float* scratch = u + Nu * W;
+  float* x = work;                // kNx x W
+  float* u2 = x + D::kNx * W;     // 2 steps x kNu x W
+  float* scratch = u2 + 2 * Nu * W;
   alignas(64) float state_cost[W] = {};
   alignas(64) float control_cost[W] = {};
   for (int i = 0; i < D::kNx; ++i) std::fill_n(x + i * W, W, a.x0[i]);
   const float valid_lanes = static_cast<float>(a.num_samples - k0);
   const std::size_t padded = static_cast<std::size_t>(a.padded);
   for (int t = 0; t < a.horizon; ++t) {
-    for (int c0 = 0; c0 < Nu; c0 += 4)
-      sample_step_block<W>(a.key, a.iteration, k0, valid_lanes, t, c0, std::min(4, Nu - c0),
-                           a.nominal + t * Nu, a.noise_std, a.lo, a.hi, a.gamma, u + c0 * W, W,
-                           control_cost);
-    for (int c = 0; c < Nu; ++c)
-      std::memcpy(controls + (static_cast<std::size_t>(t) * Nu + c) * padded + k0, u + c * W,
-                  sizeof(float) * W);
+    if (t % 2 == 0) {
+      const int steps = std::min(2, a.horizon - t);
+      sample_step_pair<W>(a.key, a.iteration, k0, valid_lanes, t, steps, Nu, a.nominal + t * Nu,
+                          a.noise_std, a.lo, a.hi, a.gamma, u2, W, static_cast<std::size_t>(Nu) * W,
+                          control_cost);
+      for (int r = 0; r < steps * Nu; ++r)
+        std::memcpy(controls + (static_cast<std::size_t>(t) * Nu + r) * padded + k0, u2 + r * W,
+                    sizeof(float) * W);
+    }
+    const float* u = u2 + (t % 2) * Nu * W;
     model.template step<W>(Batch<D::kNx, W>{x}, ConstBatch<Nu, W>{u}, a.dt_s, scratch);
     cost.template accumulate<D::kNx, Nu, W>(ConstBatch<D::kNx, W>{x}, ConstBatch<Nu, W>{u}, t,
                                             state_cost);
@@ -269,7 +273,8 @@ class CpuBackend final : public Backend {
     if (num_samples < 1 || horizon < 1) throw Error("CpuBackend: need num_samples, horizon >= 1");
     shape_ = {num_samples, padded_sample_count(num_samples), horizon, D::kNx, D::kNu};
     threads_ = runner_.threads();
-    work_floats_ = static_cast<std::size_t>((D::kNx + D::kNu) * kChunk) +
+    // state, two steps of controls (iterate_chunk; rollout_chunk uses one), model scratch
+    work_floats_ = static_cast<std::size_t>((D::kNx + 2 * D::kNu) * kChunk) +
                    model_.scratch_floats(kChunk);
     // Round each thread's slice to a cache line (16 floats) so threads never share one.
     work_floats_ = (work_floats_ + 15) / 16 * 16;
