@@ -51,7 +51,7 @@ MPPI_MULTIVERSION void rollout_chunk(const D& model, const C& cost, const float*
   }
 }
 
-// dst[i] = src[i], i in [0, n) (n a multiple of 16, dst on a cache line), written past the
+// dst[i] = src[i], i in [0, n) (n a multiple of 4, dst on 16 bytes), written past the
 // caches on x86-64 (non-temporal stores: no read of the destination lines, no eviction of the
 // working set); the caller orders them with stream_fence() before another thread reads dst.
 inline void stream_copy(float* dst, const float* src, int n) noexcept {
