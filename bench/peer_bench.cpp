@@ -8,8 +8,8 @@
 //                                  the reported time is the mean (manual time).
 //   BM_PeerNoise/K/T/threads       drawing the K x T x 2 clamped perturbed controls only
 //   BM_PeerPhilox/K/T/threads      the Philox4x32-10 words of that noise only (one call per
-//                                  sample and time step: 2 controls use 2 of its 4 words, and
-//                                  only those 2 are computed to the end)
+//                                  sample and pair of time steps: 2 controls use words 0, 1 at
+//                                  the even step and 2, 3 at the odd one)
 //   BM_PeerNormals/K/T/threads     Philox + Box-Muller (the normals, not yet clamped / stored)
 //   BM_PeerRollout/K/T/threads     backend rollout with the cost (no sampling, no update)
 //   BM_PeerDynamics/K/T/threads    backend rollout, model only (cost = 0)
@@ -148,14 +148,15 @@ MPPI_MULTIVERSION float noise_stage_chunk(std::uint32_t iteration, int chunk, in
   alignas(64) std::uint32_t words[4 * mppi::kChunk];
   alignas(64) float normals[4 * mppi::kChunk];
   float acc = 0.f;
-  for (int t = 0; t < horizon; ++t) {
+  for (int t = 0; t < horizon; t += 2) {
+    const int steps = std::min(2, horizon - t);
     if constexpr (kBoxMuller) {
       mppi::normal_block<mppi::kChunk>(mppi::NoiseKey{1}, iteration, static_cast<std::uint32_t>(chunk * mppi::kChunk),
-                                       static_cast<std::uint32_t>(t), 0u, normals, 1);
+                                       static_cast<std::uint32_t>(t / 2), 0u, normals, steps);
       acc += normals[t % mppi::kChunk];
     } else {
       mppi::detail::philox_words_dispatch<mppi::kChunk>(1u, 0u, iteration, static_cast<std::uint32_t>(chunk * mppi::kChunk),
-                                                        static_cast<std::uint32_t>(t), 0u, words, 2);
+                                                        static_cast<std::uint32_t>(t / 2), 0u, words, 2 * steps);
       acc += static_cast<float>(words[t % mppi::kChunk]);
     }
   }

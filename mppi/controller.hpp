@@ -64,11 +64,10 @@ MPPI_MULTIVERSION inline void sample_chunk(const NoiseKey& key, std::uint32_t it
   alignas(64) float acc[W] = {};
   const float valid_lanes = static_cast<float>(num_samples - k0);  // lanes j >= this get no noise
   const auto stride = static_cast<std::size_t>(padded);
-  for (int t = 0; t < horizon; ++t)
-    for (int c0 = 0; c0 < nu; c0 += 4)
-      sample_step_block<W>(key, iteration, k0, valid_lanes, t, c0, std::min(4, nu - c0), nominal + t * nu,
-                           noise_std, lo, hi, gamma, controls + (static_cast<std::size_t>(t) * nu + c0) * stride + k0,
-                           stride, acc);
+  for (int t = 0; t < horizon; t += 2)
+    sample_step_pair<W>(key, iteration, k0, valid_lanes, t, std::min(2, horizon - t), nu, nominal + t * nu,
+                        noise_std, lo, hi, gamma, controls + static_cast<std::size_t>(t) * nu * stride + k0,
+                        stride, static_cast<std::size_t>(nu) * stride, acc);
   std::copy_n(acc, W, control_cost + k0);
 }
 }  // namespace detail

@@ -51,6 +51,22 @@ MPPI_MULTIVERSION void rollout_chunk(const D& model, const C& cost, const float*
   }
 }
 
+// dst[i] = src[i], i in [0, n) (n a multiple of 4, dst on 16 bytes), written past the
+// caches on x86-64 (non-temporal stores: no read of the destination lines, no eviction of the
+// working set); the caller orders them with stream_fence() before another thread reads dst.
+inline void stream_copy(float* dst, const float* src, int n) noexcept {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  for (int i = 0; i < n; i += 4) _mm_stream_ps(dst + i, _mm_loadu_ps(src + i));
+#else
+  std::memcpy(dst, src, sizeof(float) * static_cast<std::size_t>(n));
+#endif
+}
+inline void stream_fence() noexcept {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  _mm_sfence();
+#endif
+}
+
 // What iterate_chunk leaves for the combination of the chunks (one cache line per chunk).
 struct alignas(64) ChunkTotals {
   float min_cost = 0.f;   // min of the chunk's finite S_k (+inf if none)
@@ -141,36 +157,41 @@ inline void chunk_partial_sums(const float* e, const float* v, std::size_t padde
 }
 
 // One chunk of samples [k0, k0 + kChunk) of a whole iteration, fused so that each time step's
-// noise and controls are used while they are in L1: per step t, draw V_t = clamp(U_t + eps)
-// (sample_step_block, the numbers of Controller's sampling pass), store it into `controls`
-// (T x nu x padded, kept for the caller) and step the model and cost with it. Then the chunk's
-// share of the update with weights relative to the chunk's own minimum:
+// noise and controls are used while they are in L1: per pair of steps t, t + 1 draw
+// V = clamp(U + eps) for both (sample_step_pair, the numbers of Controller's sampling pass; one
+// Philox call per lane and channel pair serves both steps) into the chunk's own T x nu x kChunk
+// block of `work`, copy them to `controls` (T x nu x padded, kept for the caller) with
+// non-temporal stores, then step the model and cost with each. Then the chunk's share of the
+// update, from its own block (in L1/L2), with weights relative to the chunk's own minimum:
 //   e_k = exp(-(S_k - m_c) / lambda),  partial[t * nu + c] = sum_k e_k V_k,t,c
 // (the caller rescales by exp(-(m_c - min S) / lambda): the same weights as the two-pass form,
 // up to rounding). costs, expw: the chunk's S_k and e_k (k - k0 in [0, kChunk)).
-// work: D::kNx*kChunk + D::kNu*kChunk + model scratch floats.
+// work: (D::kNx + T * D::kNu) * kChunk + model scratch floats.
 template <class D, class C>
 MPPI_MULTIVERSION void iterate_chunk(const D& model, const C& cost, const IterationArgs& a,
                                      int k0, float* work, float* controls, float* costs,
                                      float* expw, float* partial, ChunkTotals* totals) noexcept {
   constexpr int W = kChunk;
   constexpr int Nu = D::kNu;
-  float* x = work;            // kNx x W
-  float* u = x + D::kNx * W;  // kNu x W
-  float* scratch = u + Nu * W;
+  float* x = work;             // kNx x W
+  float* v = x + D::kNx * W;   // T x kNu x W: the chunk's sampled controls
+  float* scratch = v + static_cast<std::size_t>(a.horizon) * Nu * W;
   alignas(64) float state_cost[W] = {};
   alignas(64) float control_cost[W] = {};
   for (int i = 0; i < D::kNx; ++i) std::fill_n(x + i * W, W, a.x0[i]);
   const float valid_lanes = static_cast<float>(a.num_samples - k0);
   const std::size_t padded = static_cast<std::size_t>(a.padded);
   for (int t = 0; t < a.horizon; ++t) {
-    for (int c0 = 0; c0 < Nu; c0 += 4)
-      sample_step_block<W>(a.key, a.iteration, k0, valid_lanes, t, c0, std::min(4, Nu - c0),
-                           a.nominal + t * Nu, a.noise_std, a.lo, a.hi, a.gamma, u + c0 * W, W,
-                           control_cost);
-    for (int c = 0; c < Nu; ++c)
-      std::memcpy(controls + (static_cast<std::size_t>(t) * Nu + c) * padded + k0, u + c * W,
-                  sizeof(float) * W);
+    if (t % 2 == 0) {
+      const int steps = std::min(2, a.horizon - t);
+      float* vt = v + static_cast<std::size_t>(t) * Nu * W;
+      sample_step_pair<W>(a.key, a.iteration, k0, valid_lanes, t, steps, Nu, a.nominal + t * Nu,
+                          a.noise_std, a.lo, a.hi, a.gamma, vt, W, static_cast<std::size_t>(Nu) * W,
+                          control_cost);
+      for (int r = 0; r < steps * Nu; ++r)
+        stream_copy(controls + (static_cast<std::size_t>(t) * Nu + r) * padded + k0, vt + r * W, W);
+    }
+    const float* u = v + static_cast<std::size_t>(t) * Nu * W;
     model.template step<W>(Batch<D::kNx, W>{x}, ConstBatch<Nu, W>{u}, a.dt_s, scratch);
     cost.template accumulate<D::kNx, Nu, W>(ConstBatch<D::kNx, W>{x}, ConstBatch<Nu, W>{u}, t,
                                             state_cost);
@@ -201,8 +222,9 @@ MPPI_MULTIVERSION void iterate_chunk(const D& model, const C& cost, const Iterat
   tot.eta = eta;
   std::copy_n(e, W, expw);
   *totals = tot;
-  // partial sums of e_k V_k, read back from `controls` while the chunk is still in L1/L2
-  chunk_partial_sums(e, controls + k0, padded, a.horizon * Nu, partial);
+  // partial sums of e_k V_k, from the chunk's own block (in L1/L2)
+  chunk_partial_sums(e, v, W, a.horizon * Nu, partial);
+  stream_fence();
 }
 
 // The chunks' shares combined in chunk order (so independent of the thread count): weights
@@ -269,7 +291,9 @@ class CpuBackend final : public Backend {
     if (num_samples < 1 || horizon < 1) throw Error("CpuBackend: need num_samples, horizon >= 1");
     shape_ = {num_samples, padded_sample_count(num_samples), horizon, D::kNx, D::kNu};
     threads_ = runner_.threads();
-    work_floats_ = static_cast<std::size_t>((D::kNx + D::kNu) * kChunk) +
+    // state, the chunk's T steps of controls (iterate_chunk; rollout_chunk uses one), model
+    // scratch
+    work_floats_ = static_cast<std::size_t>(D::kNx + horizon * D::kNu) * kChunk +
                    model_.scratch_floats(kChunk);
     // Round each thread's slice to a cache line (16 floats) so threads never share one.
     work_floats_ = (work_floats_ + 15) / 16 * 16;

@@ -1,12 +1,13 @@
 #pragma once
 // Counter-based Gaussian noise: Philox4x32-10 (Salmon et al., SC'11, the generator of
-// Random123) keyed by the seed, with counter (sample, time step, iteration, channel block),
-// so every draw depends only on its own indices: the same numbers whatever the thread count,
-// and the same on the GPU. Each Philox call gives 4 words -> 2 Box-Muller pairs -> the normals
-// of 4 consecutive channels. Written lane-wise so a batch of samples vectorises; tests check it
-// against Random123's own philox4x32 and the normal distribution. On x86-64 the Philox words
-// come from AVX-512 / AVX2 code when the CPU has it (the very same words, see
-// detail::philox_words_dispatch).
+// Random123) keyed by the seed, with counter (sample, step pair, iteration, channel pair), so
+// every draw depends only on its own indices: the same numbers whatever the thread count, and
+// the same on the GPU. Each Philox call gives 4 words -> 2 Box-Muller pairs: words 0 and 1 give
+// channels 2b and 2b + 1 at the even step 2p, words 2 and 3 the same channels at step 2p + 1
+// (counter (sample, p, iteration, b)), so a model with 2 controls needs one call per two steps.
+// Written lane-wise so a batch of samples vectorises; tests check it against Random123's own
+// philox4x32 and the normal distribution. On x86-64 the Philox words come from AVX-512 / AVX2
+// code when the CPU has it (the very same words, see detail::philox_words_dispatch).
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -209,7 +210,7 @@ __attribute__((target("avx512f"))) inline void philox_words_avx512(
 }
 
 // Words 0 and 1 only (words + 0 * lanes, words + 1 * lanes; the same as philox_words_avx512's),
-// for a model with at most 2 controls, whose Box-Muller pair uses only those. The last three
+// for the last step of an odd horizon, whose Box-Muller pair uses only those. The last three
 // rounds skip what cannot reach them: round 10 needs only c1, c2 of round 9; round 9 gives c1
 // and c2 from c0, c2, c3 of round 8, which needs no c1.
 // lanes: a multiple of 32.
@@ -308,20 +309,23 @@ inline void philox_words_dispatch(std::uint32_t k0, std::uint32_t k1, std::uint3
 }
 }  // namespace detail
 
-// Standard normals for W consecutive samples starting at `first_sample`, at time step t and
-// iteration `iteration`, channels [4*block, 4*block + 2*pairs): out[ch * W + lane]. pairs = 2
-// gives all 4 channels of the block; pairs = 1 only channels 4*block and 4*block + 1 (their
-// Box-Muller pair uses words 0 and 1 only, so a model with 2 controls skips half the work).
+// Standard normals for W consecutive samples starting at `first_sample`, at iteration
+// `iteration`, steps 2 * step_pair and 2 * step_pair + 1, channels 2 * channel_pair and
+// 2 * channel_pair + 1: out[(2 * s + i) * W + lane] is step 2 * step_pair + s, channel
+// 2 * channel_pair + i (one Philox call per lane). steps = 1 gives the first step only (its
+// Box-Muller pair uses words 0 and 1 only, so the last step of an odd horizon skips half the
+// work).
 template <int W>
 inline void normal_block(const NoiseKey& key, std::uint32_t iteration, std::uint32_t first_sample,
-                         std::uint32_t t, std::uint32_t block, float* out, int pairs = 2) noexcept {
+                         std::uint32_t step_pair, std::uint32_t channel_pair, float* out,
+                         int steps = 2) noexcept {
   alignas(64) std::uint32_t words[4 * W];
   detail::philox_words_dispatch<W>(static_cast<std::uint32_t>(key.seed),
                                    static_cast<std::uint32_t>(key.seed >> 32), iteration,
-                                   first_sample, t, block, words, 2 * pairs);
+                                   first_sample, step_pair, channel_pair, words, 2 * steps);
   MPPI_SIMD_LOOP
   for (int j = 0; j < W; ++j) box_muller(words[j], words[W + j], &out[0 * W + j], &out[1 * W + j]);
-  if (pairs > 1) {
+  if (steps > 1) {
     MPPI_SIMD_LOOP
     for (int j = 0; j < W; ++j)
       box_muller(words[2 * W + j], words[3 * W + j], &out[2 * W + j], &out[3 * W + j]);
@@ -331,12 +335,13 @@ inline void normal_block(const NoiseKey& key, std::uint32_t iteration, std::uint
 // One normal, scalar: the reference the batched paths must reproduce exactly.
 inline float normal_at(const NoiseKey& key, std::uint32_t iteration, std::uint32_t sample,
                        std::uint32_t t, int channel) noexcept {
-  std::uint32_t c[4] = {sample, t, iteration, static_cast<std::uint32_t>(channel / 4)};
+  const auto pair = static_cast<std::uint32_t>(channel / 2);
+  std::uint32_t c[4] = {sample, t / 2, iteration, pair};
   philox4x32_10(c, static_cast<std::uint32_t>(key.seed), static_cast<std::uint32_t>(key.seed >> 32));
-  float n[4];
-  box_muller(c[0], c[1], &n[0], &n[1]);
-  box_muller(c[2], c[3], &n[2], &n[3]);
-  return n[channel % 4];
+  const int w = 2 * static_cast<int>(t % 2);  // words 0, 1 for an even step, 2, 3 for an odd one
+  float n[2];
+  box_muller(c[w], c[w + 1], &n[0], &n[1]);
+  return n[channel % 2];
 }
 
 }  // namespace mppi

@@ -15,12 +15,17 @@ void main() {
   [[unroll]] for (int i = 0; i < NX; ++i) x[i] = step_data.x0[i >> 2][i & 3];
   precise float cost = 0.0;
   precise float control_cost = 0.0;
+  uvec4 words = uvec4(0u);
   for (int t = 0; t < horizon; ++t) {
     float u[NU];
     if (kGenerate) {
-      uvec4 c = uvec4(k, uint(t), iteration, 0u);  // (sample, t, iteration, channel block)
-      philox4x32_10(c, step_data.seed.x, step_data.seed.y);
-      vec2 n = box_muller(c.x, c.y);  // channels 0 and 1 (NU = 2: one block)
+      // one Philox call per step pair: counter (sample, t / 2, iteration, channel pair 0); words
+      // 0, 1 give channels 0 and 1 at the even step, words 2, 3 at the odd one (NU = 2)
+      if ((t & 1) == 0) {
+        words = uvec4(k, uint(t) >> 1, iteration, 0u);
+        philox4x32_10(words, step_data.seed.x, step_data.seed.y);
+      }
+      vec2 n = (t & 1) == 0 ? box_muller(words.x, words.y) : box_muller(words.z, words.w);
       [[unroll]] for (int ch = 0; ch < NU; ++ch) {
         precise float un = nominal[t * NU + ch];
         precise float sd = step_data.noise_std[ch];
