@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <utility>
@@ -83,7 +84,12 @@ class CostMap {
   static CostMap load_npz(const std::string& path);
   // Any image OpenCV reads (PNG, ...), 8 or 16 bits, 1/3/4 channels (gray counts as R=G=B,
   // missing alpha as 255). The image must be exactly W x H pixels for the spec's bounds.
+  // Reads the file's bytes and hands them to decode_image.
   static CostMap load_image(const std::string& path, const ImageMapSpec& spec);
+  // The same from the bytes of an image file in memory (all of load_image's checks happen
+  // here); `source` names them in error messages (load_image passes the path).
+  static CostMap decode_image(const std::uint8_t* bytes, std::size_t size, const std::string& source,
+                              const ImageMapSpec& spec);
   // AutoRally's <track>.cfg (a Python dict: xBounds, yBounds, pixelsPerMeter, rOffset,
   // rNormalizer, ..., channelMap, imageRotation, flip) -> the spec for the image channel that
   // becomes channel0. Like track_generator.py it ignores "flip"; imageRotation must be 0.
