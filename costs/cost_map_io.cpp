@@ -1,6 +1,7 @@
 // Cost-map loaders: AutoRally npz, images through OpenCV, AutoRally's track .cfg.
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <optional>
@@ -30,6 +31,19 @@ float single_value(const NpzFile& npz, const std::string& key) {
     throw Error(npz.path() + ": array '" + key + "' has " + std::to_string(a.size()) +
                 " values, expected 1");
   return static_cast<float>(a.values[0]);
+}
+
+// The formats whose signature OpenCV 4's imdecode would hand to a decoder that reads only
+// from a file (it writes the bytes to a temporary file first); their name, or nullptr.
+// Signatures as OpenCV's decoders check them (grfmt_hdr, grfmt_exr, grfmt_gdcm).
+const char* needs_temporary_file(const std::uint8_t* bytes, std::size_t size) {
+  const auto starts_with = [&](std::size_t at, const char* magic, std::size_t n) {
+    return size >= at + n && std::memcmp(bytes + at, magic, n) == 0;
+  };
+  if (starts_with(0, "#?RGBE", 6) || starts_with(0, "#?RADIANCE", 10)) return "Radiance HDR";
+  if (starts_with(0, "\x76\x2f\x31\x01", 4)) return "OpenEXR";
+  if (starts_with(128, "DICM", 4)) return "DICOM";
+  return nullptr;
 }
 
 }  // namespace
@@ -95,6 +109,9 @@ CostMap CostMap::decode_image(const std::uint8_t* bytes, std::size_t size, const
   if (channel < 0 || channel > 3) throw Error(source + ": bad ImageMapSpec: channel must be R, G, B or A");
 
   if (size == 0) throw Error(source + ": no image data (empty file)");
+  if (const char* format = needs_temporary_file(bytes, size))
+    throw Error(source + ": " + format + " images are not supported (need 8 or 16 bits per channel, " +
+                "decoded in memory: PNG, TIFF, BMP, ...)");
   if (size > static_cast<std::size_t>(std::numeric_limits<int>::max()))
     throw Error(source + ": image file too large (" + std::to_string(size) + " bytes)");
   cv::Mat img;
@@ -212,8 +229,10 @@ ImageMapSpec CostMap::read_autorally_track_cfg(const std::string& path) {
   if (!in) throw Error(path + ": cannot open track config");
   std::stringstream buffer;
   buffer << in.rdbuf();
-  const std::string text = buffer.str();
+  return parse_autorally_track_cfg(buffer.str(), path);
+}
 
+ImageMapSpec CostMap::parse_autorally_track_cfg(const std::string& text, const std::string& path) {
   ImageMapSpec spec;
   const auto xb = required(path, text, "xBounds", 2);
   const auto yb = required(path, text, "yBounds", 2);

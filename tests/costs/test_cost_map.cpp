@@ -376,6 +376,23 @@ TEST_CASE("track cfg: quotes, spacing, key order and decoy keys", "[costs]") {
   CHECK_THAT(msg, Catch::Contains("mppi_track_cfg_bad.cfg") && Catch::Contains("key 'xBounds'") &&
                       Catch::Contains("'one' is not a finite number"));
   for (const auto& p : {ok, missing, bad}) std::remove(p.c_str());
+
+  // The text entry point reads the same; its errors name the given source.
+  const std::string shipped = mppi::test::data_path("autorally/maps/gazebo/gazebo_track.cfg");
+  std::ifstream in(shipped);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const mppi::ImageMapSpec from_text = mppi::CostMap::parse_autorally_track_cfg(text, "in memory");
+  const mppi::ImageMapSpec from_file = mppi::CostMap::read_autorally_track_cfg(shipped);
+  CHECK(from_text.x_min_m == from_file.x_min_m);
+  CHECK(from_text.x_max_m == from_file.x_max_m);
+  CHECK(from_text.y_min_m == from_file.y_min_m);
+  CHECK(from_text.y_max_m == from_file.y_max_m);
+  CHECK(from_text.pixels_per_meter == from_file.pixels_per_meter);
+  CHECK(from_text.channel == from_file.channel);
+  CHECK(from_text.offset == from_file.offset);
+  CHECK(from_text.normalizer == from_file.normalizer);
+  msg = error_of([&] { (void)mppi::CostMap::parse_autorally_track_cfg("{\"xBounds\": [0, 1]}", "in memory"); });
+  CHECK_THAT(msg, Catch::Contains("in memory: missing key 'yBounds'"));
 }
 
 TEST_CASE("CostMap: image bytes in memory decode as the file does; bad bytes name the source", "[costs]") {
@@ -407,6 +424,17 @@ TEST_CASE("CostMap: image bytes in memory decode as the file does; bad bytes nam
     (void)mppi::CostMap::decode_image(reinterpret_cast<const std::uint8_t*>(wide.data()), wide.size(), "wide.pgm", spec);
   });
   CHECK_THAT(msg, Catch::Contains("wide.pgm: cannot decode image"));
+  // Float formats that OpenCV decodes only through a temporary file are refused before decoding.
+  const std::string hdr = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 16 +X 16\n" + std::string(64, '\x01');
+  msg = error_of([&] {
+    (void)mppi::CostMap::decode_image(reinterpret_cast<const std::uint8_t*>(hdr.data()), hdr.size(), "map.hdr", spec);
+  });
+  CHECK_THAT(msg, Catch::Contains("map.hdr: Radiance HDR images are not supported"));
+  const std::string exr = std::string("\x76\x2f\x31\x01", 4) + std::string(64, '\0');
+  msg = error_of([&] {
+    (void)mppi::CostMap::decode_image(reinterpret_cast<const std::uint8_t*>(exr.data()), exr.size(), "map.exr", spec);
+  });
+  CHECK_THAT(msg, Catch::Contains("map.exr: OpenEXR images are not supported"));
   // A file that is not there.
   msg = error_of([&] { (void)mppi::CostMap::load_image(dir + "no_such_map.png", spec); });
   CHECK_THAT(msg, Catch::Contains("no_such_map.png: cannot open image file"));
