@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <utility>
@@ -83,11 +84,23 @@ class CostMap {
   static CostMap load_npz(const std::string& path);
   // Any image OpenCV reads (PNG, ...), 8 or 16 bits, 1/3/4 channels (gray counts as R=G=B,
   // missing alpha as 255). The image must be exactly W x H pixels for the spec's bounds.
+  // Reads the file's bytes and hands them to decode_image.
   static CostMap load_image(const std::string& path, const ImageMapSpec& spec);
+  // The same from the bytes of an image file in memory (all of load_image's checks happen
+  // here); `source` names them in error messages (load_image passes the path). Decoded in
+  // memory by OpenCV: the formats that OpenCV 4 decodes only through a temporary file are
+  // refused by their signature before decoding: Radiance HDR and OpenEXR (float pixels, which a
+  // cost map refuses anyway) and DICOM.
+  static CostMap decode_image(const std::uint8_t* bytes, std::size_t size, const std::string& source,
+                              const ImageMapSpec& spec);
   // AutoRally's <track>.cfg (a Python dict: xBounds, yBounds, pixelsPerMeter, rOffset,
   // rNormalizer, ..., channelMap, imageRotation, flip) -> the spec for the image channel that
   // becomes channel0. Like track_generator.py it ignores "flip"; imageRotation must be 0.
+  // Reads the file and hands its text to parse_autorally_track_cfg.
   static ImageMapSpec read_autorally_track_cfg(const std::string& path);
+  // The same from the text of such a file (all of the reader's checks happen here); `source`
+  // names it in error messages (read_autorally_track_cfg passes the path).
+  static ImageMapSpec parse_autorally_track_cfg(const std::string& text, const std::string& source);
 
   float x_min_m() const noexcept { return x_min_m_; }
   float x_max_m() const noexcept { return x_max_m_; }

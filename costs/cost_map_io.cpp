@@ -1,9 +1,10 @@
 // Cost-map loaders: AutoRally npz, images through OpenCV, AutoRally's track .cfg.
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
+#include <limits>
 #include <optional>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -11,10 +12,12 @@
 // OpenCV 4's headers mix enum types, which C++20 deprecates; not our code.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wdeprecated-enum-enum-conversion"
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #pragma GCC diagnostic pop
 
 #include "costs/cost_map.hpp"
+#include "costs/python_dict_text.hpp"
 #include "dynamics/npz.hpp"
 #include "mppi/error.hpp"
 
@@ -28,6 +31,19 @@ float single_value(const NpzFile& npz, const std::string& key) {
     throw Error(npz.path() + ": array '" + key + "' has " + std::to_string(a.size()) +
                 " values, expected 1");
   return static_cast<float>(a.values[0]);
+}
+
+// The formats whose signature OpenCV 4's imdecode would hand to a decoder that reads only
+// from a file (it writes the bytes to a temporary file first); their name, or nullptr.
+// Signatures as OpenCV's decoders check them (grfmt_hdr, grfmt_exr, grfmt_gdcm).
+const char* needs_temporary_file(const std::uint8_t* bytes, std::size_t size) {
+  const auto starts_with = [&](std::size_t at, const char* magic, std::size_t n) {
+    return size >= at + n && std::memcmp(bytes + at, magic, n) == 0;
+  };
+  if (starts_with(0, "#?RGBE", 6) || starts_with(0, "#?RADIANCE", 10)) return "Radiance HDR";
+  if (starts_with(0, "\x76\x2f\x31\x01", 4)) return "OpenEXR";
+  if (starts_with(128, "DICM", 4)) return "DICOM";
+  return nullptr;
 }
 
 }  // namespace
@@ -68,38 +84,64 @@ CostMap CostMap::load_npz(const std::string& path) {
 }
 
 CostMap CostMap::load_image(const std::string& path, const ImageMapSpec& spec) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open image file");
+  std::vector<std::uint8_t> bytes;
+  char chunk[1 << 16];
+  while (in.read(chunk, sizeof chunk) || in.gcount() > 0)
+    bytes.insert(bytes.end(), chunk, chunk + in.gcount());
+  if (in.bad()) throw Error(path + ": cannot read image file");
+  return decode_image(bytes.data(), bytes.size(), path, spec);
+}
+
+CostMap CostMap::decode_image(const std::uint8_t* bytes, std::size_t size, const std::string& source,
+                              const ImageMapSpec& spec) {
   int width = 0, height = 0;
   try {
     width = pixel_count(spec.x_min_m, spec.x_max_m, spec.pixels_per_meter, "x");
     height = pixel_count(spec.y_min_m, spec.y_max_m, spec.pixels_per_meter, "y");
   } catch (const Error& e) {
-    throw Error(path + ": bad ImageMapSpec: " + e.what());
+    throw Error(source + ": bad ImageMapSpec: " + e.what());
   }
   if (!std::isfinite(spec.offset) || !std::isfinite(spec.normalizer) || spec.normalizer == 0.f)
-    throw Error(path + ": bad ImageMapSpec: offset must be finite and normalizer finite and non-zero");
+    throw Error(source + ": bad ImageMapSpec: offset must be finite and normalizer finite and non-zero");
   const int channel = static_cast<int>(spec.channel);
-  if (channel < 0 || channel > 3) throw Error(path + ": bad ImageMapSpec: channel must be R, G, B or A");
+  if (channel < 0 || channel > 3) throw Error(source + ": bad ImageMapSpec: channel must be R, G, B or A");
 
-  const cv::Mat img = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (img.empty()) throw Error(path + ": cannot read image (missing file or unsupported format)");
+  if (size == 0) throw Error(source + ": no image data (empty file)");
+  if (const char* format = needs_temporary_file(bytes, size))
+    throw Error(source + ": " + format + " images are not supported (need 8 or 16 bits per channel, " +
+                "decoded in memory: PNG, TIFF, BMP, ...)");
+  if (size > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    throw Error(source + ": image file too large (" + std::to_string(size) + " bytes)");
+  cv::Mat img;
+  try {
+    // A 1 x size view of the bytes, no copy; IMREAD_UNCHANGED as imread had: no EXIF rotation.
+    const cv::Mat encoded(1, static_cast<int>(size), CV_8U, const_cast<std::uint8_t*>(bytes));
+    img = cv::imdecode(encoded, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {  // e.g. a header whose size is beyond OpenCV's limits
+    throw Error(source + ": cannot decode image: " + e.err);
+  }
+  if (img.empty()) throw Error(source + ": cannot decode image (unsupported format or corrupt data)");
   if (img.depth() != CV_8U && img.depth() != CV_16U)
-    throw Error(path + ": unsupported image depth (need 8 or 16 bits per channel)");
+    throw Error(source + ": unsupported image depth (need 8 or 16 bits per channel)");
   const int n_channels = img.channels();
   if (n_channels < 1 || n_channels > 4)
-    throw Error(path + ": unsupported number of channels " + std::to_string(n_channels));
+    throw Error(source + ": unsupported number of channels " + std::to_string(n_channels));
   if (img.cols != width || img.rows != height)
-    throw Error(path + ": image is " + std::to_string(img.cols) + " x " + std::to_string(img.rows) +
+    throw Error(source + ": image is " + std::to_string(img.cols) + " x " + std::to_string(img.rows) +
                 " pixels, the spec's bounds and pixels_per_meter need " + std::to_string(width) +
                 " x " + std::to_string(height));
 
-  // OpenCV stores colour as BGR(A). -1 = the channel is absent: alpha of an opaque image.
-  int source = -1;
+  // OpenCV stores colour as BGR(A). cell_channel: where the spec's channel lies within a pixel;
+  // -1: absent (the alpha of an opaque image).
+  int cell_channel = -1;
   if (n_channels >= 3) {
     const int bgra[4] = {2, 1, 0, 3};  // index of R, G, B, A
-    source = bgra[channel];
-    if (source >= n_channels) source = -1;
+    cell_channel = bgra[channel];
+    if (cell_channel >= n_channels) cell_channel = -1;
   } else {  // gray (+ alpha): gray counts as R = G = B
-    source = (channel == 3) ? (n_channels == 2 ? 1 : -1) : 0;
+    cell_channel = (channel == 3) ? (n_channels == 2 ? 1 : -1) : 0;
   }
   const bool is16 = img.depth() == CV_16U;
   const float opaque = is16 ? 65535.f : 255.f;
@@ -110,8 +152,8 @@ CostMap CostMap::load_image(const std::string& path, const ImageMapSpec& spec) {
     float* out = values.data() + static_cast<std::size_t>(map_row) * width;
     for (int c = 0; c < width; ++c) {
       float raw = opaque;
-      if (source >= 0) {
-        const std::size_t k = static_cast<std::size_t>(c) * n_channels + source;
+      if (cell_channel >= 0) {
+        const std::size_t k = static_cast<std::size_t>(c) * n_channels + cell_channel;
         raw = is16 ? static_cast<float>(img.ptr<std::uint16_t>(r)[k])
                    : static_cast<float>(img.ptr<std::uint8_t>(r)[k]);
       }
@@ -122,7 +164,7 @@ CostMap CostMap::load_image(const std::string& path, const ImageMapSpec& spec) {
     return CostMap(spec.x_min_m, spec.x_max_m, spec.y_min_m, spec.y_max_m, spec.pixels_per_meter,
                    std::move(values));
   } catch (const Error& e) {
-    throw Error(path + ": " + e.what());
+    throw Error(source + ": " + e.what());
   }
 }
 
@@ -130,10 +172,9 @@ namespace {
 
 // The raw text of `"key": value` in a Python-dict file: a [list] or a bare token.
 std::optional<std::string> dict_value(const std::string& text, const std::string& key) {
-  const std::regex re("[\"']" + key + "[\"']\\s*:\\s*(\\[[^\\]]*\\]|[^,}\\s]+)");
-  std::smatch m;
-  if (!std::regex_search(text, m, re)) return std::nullopt;
-  return m[1].str();
+  const auto value = python_dict_value(text, key);
+  if (!value) return std::nullopt;
+  return std::string(*value);
 }
 
 std::vector<double> dict_numbers(const std::string& path, const std::string& key, const std::string& raw) {
@@ -188,8 +229,10 @@ ImageMapSpec CostMap::read_autorally_track_cfg(const std::string& path) {
   if (!in) throw Error(path + ": cannot open track config");
   std::stringstream buffer;
   buffer << in.rdbuf();
-  const std::string text = buffer.str();
+  return parse_autorally_track_cfg(buffer.str(), path);
+}
 
+ImageMapSpec CostMap::parse_autorally_track_cfg(const std::string& text, const std::string& path) {
   ImageMapSpec spec;
   const auto xb = required(path, text, "xBounds", 2);
   const auto yb = required(path, text, "yBounds", 2);

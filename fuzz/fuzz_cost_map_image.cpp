@@ -1,5 +1,7 @@
-// Cost-map image loader (costs/cost_map_io.cpp over OpenCV's image readers) for a 16 x 16 pixel
+// Cost-map image loader (costs/cost_map_io.cpp over OpenCV's image decoders) for a 16 x 16 pixel
 // map (bounds 0..1.6 m at 10 pixels per meter); the first byte picks the channel and the row order.
+// The rest is decoded from memory by CostMap::decode_image, the part of CostMap::load_image after
+// it has read the file (every check of the loader is there; no file is written per input).
 #include "costs/cost_map.hpp"
 #include "fuzz/fuzz_input.hpp"
 
@@ -13,7 +15,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   spec.pixels_per_meter = 10.f;
   spec.channel = static_cast<mppi::ImageMapSpec::Channel>(data[0] % 4);
   spec.row0_is_y_max = (data[0] & 4) != 0;
-  const std::string path = mppi::fuzz::write_temp_file(data + 1, size - 1, ".png");
-  mppi::fuzz::expect_value_or_error([&] { mppi::CostMap::load_image(path, spec); });
+  mppi::fuzz::expect_value_or_error([&] { mppi::CostMap::decode_image(data + 1, size - 1, "fuzz input", spec); });
   return 0;
 }

@@ -5,6 +5,11 @@
 # A crash, leak, sanitizer report, timeout or an exception other than mppi::Error fails the run;
 # the input is kept as build-fuzz/artifacts/<target>-crash-... (reproduce: the target binary
 # with that file as its argument). Figures per target: build-fuzz/fuzz-summary.txt.
+# OpenCV's image decoders refuse images above 1 Mpixel in these runs (OPENCV_IO_MAX_IMAGE_PIXELS;
+# its default is 1 Gpixel): a few bytes of WebP or PNG header can ask for a 1 GB image, which
+# OpenCV allocates and fills before the cost-map loader compares its size with the map's, and
+# a fuzzer that finds such a header would spend its time decoding it (fuzz_cost_map_image's
+# map has 256 pixels).
 #
 # Usage: scripts/fuzz.sh [seconds] [runs] [target ...]   e.g. scripts/fuzz.sh 600 1000000 fuzz_npz
 set -euo pipefail
@@ -39,7 +44,7 @@ for t in "${targets[@]}"; do
   log="build-fuzz/$t.log"
   start=$SECONDS
   rc=0
-  ASAN_OPTIONS="detect_leaks=1" UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1" \
+  ASAN_OPTIONS="detect_leaks=1" UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1" OPENCV_IO_MAX_IMAGE_PIXELS=1048576 \
     "build-fuzz/fuzz/$t" -max_total_time="$seconds" -runs="$runs" -timeout=10 -rss_limit_mb=2048 \
     -print_final_stats=1 -artifact_prefix="build-fuzz/artifacts/$t-" \
     "build-fuzz/corpus/$t" "fuzz/corpus/$t" >"$log" 2>&1 || rc=$?

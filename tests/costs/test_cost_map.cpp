@@ -6,11 +6,16 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <limits>
+#include <optional>
+#include <random>
+#include <regex>
 #include <string>
 #include <vector>
 
 #include "costs/cost_map.hpp"
+#include "costs/python_dict_text.hpp"
 #include "dynamics/npz.hpp"
 #include "mppi/error.hpp"
 #include "error_of.hpp"
@@ -250,4 +255,187 @@ TEST_CASE("CostMap: bad npz files give errors naming the file and the array", "[
   with_nan[3] = std::numeric_limits<float>::quiet_NaN();
   msg = error_of([&] { (void)mppi::CostMap(0.f, 1.f, 0.f, 1.f, 2.f, with_nan); });
   CHECK_THAT(msg, Catch::Contains("NaN at row 1, col 1"));
+}
+
+namespace {
+
+std::optional<std::string> dict_value(const std::string& text, const std::string& key) {
+  const auto v = mppi::python_dict_value(text, key);
+  if (!v) return std::nullopt;
+  return std::string(*v);
+}
+
+// The grammar of python_dict_value as a regular expression (the reader's earlier implementation):
+// the reference the scanner is compared with on generated text.
+std::optional<std::string> dict_value_by_regex(const std::string& text, const std::string& key) {
+  const std::regex re("[\"']" + key + "[\"']\\s*:\\s*(\\[[^\\]]*\\]|[^,}\\s]+)");
+  std::smatch m;
+  if (!std::regex_search(text, m, re)) return std::nullopt;
+  return m[1].str();
+}
+
+std::string write_text(const std::string& file_name, const std::string& text) {
+  const auto path = (std::filesystem::temp_directory_path() / file_name).string();
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+}  // namespace
+
+TEST_CASE("python_dict_value: hand-written cases", "[costs]") {
+  const std::optional<std::string> none;
+  // A key that is the start of another key: "x" is not found inside "xBounds".
+  const std::string bounds = "{\"xBounds\":[-25, 10], \n\"x\": 3}";
+  CHECK(dict_value(bounds, "xBounds") == "[-25, 10]");
+  CHECK(dict_value(bounds, "x") == "3");
+  CHECK(dict_value(bounds, "Bounds") == none);  // not quoted on its left
+  CHECK(dict_value("{\"xBounds\":[1, 2]}", "x") == none);
+  // Single quotes, double quotes, and one of each (the reader accepts either on each side).
+  CHECK(dict_value("{'pixelsPerMeter': [20]}", "pixelsPerMeter") == "[20]");
+  CHECK(dict_value("{\"pixelsPerMeter\": [20]}", "pixelsPerMeter") == "[20]");
+  CHECK(dict_value("{'rOffset\": 7}", "rOffset") == "7");
+  // Whitespace (spaces, tabs, newlines) on both sides of ':'.
+  CHECK(dict_value("{\"rOffset\" \t:\n  -255 , }", "rOffset") == "-255");
+  CHECK(dict_value("{\"rOffset\"\n:-255}", "rOffset") == "-255");
+  // A missing key; empty text.
+  CHECK(dict_value("{\"rOffset\": 0}", "rNormalizer") == none);
+  CHECK(dict_value("", "rOffset") == none);
+  // A list keeps its inner spaces and brackets; it ends at the first ']' (a '}' or a newline
+  // inside does not end it).
+  CHECK(dict_value("{\"channelMap\":  [ 0, 1 ,2,3 ] ,\"flip\":False}", "channelMap") == "[ 0, 1 ,2,3 ]");
+  CHECK(dict_value("{\"a\": [1,\n}2], \"b\": 4}", "a") == "[1,\n}2]");
+  // An unclosed list is a bare token: up to the next ',', '}' or whitespace.
+  CHECK(dict_value("{\"a\": [1, 2", "a") == "[1");
+  // A bare token ends at ',', '}' or whitespace.
+  CHECK(dict_value("{\"flip\":False}", "flip") == "False");
+  CHECK(dict_value("{\"a\":1.5e-3,\"b\":2}", "a") == "1.5e-3");
+  CHECK(dict_value("{\"a\":x y}", "a") == "x");
+  // The key written only as another key's value is not a key; a later real place is found.
+  CHECK(dict_value("{\"name\": \"x\", \"note\": \"xBounds\"}", "x") == none);
+  CHECK(dict_value("{\"name\": \"x\", \"note\": \"xBounds\"}", "xBounds") == none);
+  CHECK(dict_value("{\"name\": \"x\", \"x\": 5}", "x") == "5");
+  // No value after ':' (',' or '}' or the end): that place does not count.
+  CHECK(dict_value("{\"x\": , \"x\": 2}", "x") == "2");
+  CHECK(dict_value("{\"x\":}", "x") == none);
+  CHECK(dict_value("{\"x\":   ", "x") == none);
+  // The first place wins.
+  CHECK(dict_value("{'x': 1, 'x': 2}", "x") == "1");
+}
+
+TEST_CASE("python_dict_value: same answers as the regular expression on generated text", "[costs]") {
+  // Text made of the pieces that matter to the grammar (quotes, keys, ':', brackets, separators,
+  // whitespace, quoted keys), so that they meet in every order; short enough to be read.
+  const std::vector<std::string> pieces = {"\"", "'", "x", "xB", ":", " ", "\n\t", "[", "]", ",", "}",
+                                           "1", "-3.5", "\"x\"", "'x'", "\"xB'", " : ", "[1, 2]"};
+  std::mt19937 rng(20261126);
+  std::uniform_int_distribution<int> length(0, 12);
+  std::uniform_int_distribution<std::size_t> pick(0, pieces.size() - 1);
+  int found = 0, mismatches = 0;
+  for (int n = 0; n < 20000; ++n) {
+    std::string text;
+    for (int k = length(rng); k > 0; --k) text += pieces[pick(rng)];
+    for (const std::string key : {"x", "xB"}) {
+      const auto expected = dict_value_by_regex(text, key);
+      found += expected.has_value();
+      if (dict_value(text, key) != expected) {
+        ++mismatches;
+        UNSCOPED_INFO("key " << key << " in [" << text << "]");
+      }
+    }
+  }
+  CHECK(mismatches == 0);
+  CHECK(found > 1000);  // the generated text does exercise the matches, not only misses
+}
+
+TEST_CASE("track cfg: quotes, spacing, key order and decoy keys", "[costs]") {
+  // Alpha channel -> channel0 (channelMap[3] = 0), so aOffset and aNormalizer apply.
+  const std::string ok = write_text("mppi_track_cfg_ok.cfg",
+      "{'flip': False, 'note': 'xBounds',\n"
+      " 'channelMap' : [ 3, 1, 2, 0 ], 'aNormalizer': -1.0, \"aOffset\":-255,\n"
+      " 'x': [9, 9], 'xBounds' : [ -1.5 , 2.5 ], \"yBounds\":[0,1],\n"
+      " 'pixelsPerMeter':[ 4 ], \"imageRotation\"\t:\t0}\n");
+  const mppi::ImageMapSpec spec = mppi::CostMap::read_autorally_track_cfg(ok);
+  CHECK(spec.x_min_m == -1.5f);
+  CHECK(spec.x_max_m == 2.5f);
+  CHECK(spec.y_min_m == 0.f);
+  CHECK(spec.y_max_m == 1.f);
+  CHECK(spec.pixels_per_meter == 4.f);
+  CHECK(spec.channel == mppi::ImageMapSpec::Channel::kAlpha);
+  CHECK(spec.offset == -255.f);
+  CHECK(spec.normalizer == -1.f);
+
+  // pixelsPerMeter only as another key's value: missing, and the message names file and key.
+  const std::string missing = write_text("mppi_track_cfg_missing.cfg",
+      "{\"xBounds\":[0, 1], \"yBounds\":[0, 1], \"note\": \"pixelsPerMeter\"}");
+  std::string msg = error_of([&] { (void)mppi::CostMap::read_autorally_track_cfg(missing); });
+  CHECK_THAT(msg, Catch::Contains("mppi_track_cfg_missing.cfg") && Catch::Contains("missing key 'pixelsPerMeter'"));
+  // A value that is not a number.
+  const std::string bad = write_text("mppi_track_cfg_bad.cfg",
+      "{\"xBounds\":[0, one], \"yBounds\":[0, 1], \"pixelsPerMeter\": [2]}");
+  msg = error_of([&] { (void)mppi::CostMap::read_autorally_track_cfg(bad); });
+  CHECK_THAT(msg, Catch::Contains("mppi_track_cfg_bad.cfg") && Catch::Contains("key 'xBounds'") &&
+                      Catch::Contains("'one' is not a finite number"));
+  for (const auto& p : {ok, missing, bad}) std::remove(p.c_str());
+
+  // The text entry point reads the same; its errors name the given source.
+  const std::string shipped = mppi::test::data_path("autorally/maps/gazebo/gazebo_track.cfg");
+  std::ifstream in(shipped);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const mppi::ImageMapSpec from_text = mppi::CostMap::parse_autorally_track_cfg(text, "in memory");
+  const mppi::ImageMapSpec from_file = mppi::CostMap::read_autorally_track_cfg(shipped);
+  CHECK(from_text.x_min_m == from_file.x_min_m);
+  CHECK(from_text.x_max_m == from_file.x_max_m);
+  CHECK(from_text.y_min_m == from_file.y_min_m);
+  CHECK(from_text.y_max_m == from_file.y_max_m);
+  CHECK(from_text.pixels_per_meter == from_file.pixels_per_meter);
+  CHECK(from_text.channel == from_file.channel);
+  CHECK(from_text.offset == from_file.offset);
+  CHECK(from_text.normalizer == from_file.normalizer);
+  msg = error_of([&] { (void)mppi::CostMap::parse_autorally_track_cfg("{\"xBounds\": [0, 1]}", "in memory"); });
+  CHECK_THAT(msg, Catch::Contains("in memory: missing key 'yBounds'"));
+}
+
+TEST_CASE("CostMap: image bytes in memory decode as the file does; bad bytes name the source", "[costs]") {
+  const std::string dir = mppi::test::data_path("autorally/maps/gazebo/");
+  const mppi::ImageMapSpec spec = mppi::CostMap::read_autorally_track_cfg(dir + "gazebo_track.cfg");
+  std::ifstream in(dir + "gazebo_map.png", std::ios::binary);
+  const std::vector<std::uint8_t> png((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  REQUIRE(png.size() > 8);
+  const mppi::CostMap from_file = mppi::CostMap::load_image(dir + "gazebo_map.png", spec);
+  const mppi::CostMap from_bytes = mppi::CostMap::decode_image(png.data(), png.size(), "in-memory png", spec);
+  CHECK(from_bytes.width() == from_file.width());
+  CHECK(from_bytes.height() == from_file.height());
+  CHECK(from_bytes.values() == from_file.values());
+
+  std::string msg = error_of([&] { (void)mppi::CostMap::decode_image(png.data(), 0, "empty bytes", spec); });
+  CHECK_THAT(msg, Catch::Contains("empty bytes") && Catch::Contains("no image data"));
+  const std::string junk = "not an image at all";
+  msg = error_of([&] {
+    (void)mppi::CostMap::decode_image(reinterpret_cast<const std::uint8_t*>(junk.data()), junk.size(), "junk", spec);
+  });
+  CHECK_THAT(msg, Catch::Contains("junk: cannot decode image"));
+  // A truncated PNG (its header, no pixels).
+  msg = error_of([&] { (void)mppi::CostMap::decode_image(png.data(), 40, "cut.png", spec); });
+  CHECK_THAT(msg, Catch::Contains("cut.png: cannot decode image"));
+  // A header asking for more columns than OpenCV allows: OpenCV's own exception becomes an
+  // mppi::Error naming the source.
+  const std::string wide = "P5\n2000000 1\n255\n" + std::string(64, '\0');
+  msg = error_of([&] {
+    (void)mppi::CostMap::decode_image(reinterpret_cast<const std::uint8_t*>(wide.data()), wide.size(), "wide.pgm", spec);
+  });
+  CHECK_THAT(msg, Catch::Contains("wide.pgm: cannot decode image"));
+  // Float formats that OpenCV decodes only through a temporary file are refused before decoding.
+  const std::string hdr = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 16 +X 16\n" + std::string(64, '\x01');
+  msg = error_of([&] {
+    (void)mppi::CostMap::decode_image(reinterpret_cast<const std::uint8_t*>(hdr.data()), hdr.size(), "map.hdr", spec);
+  });
+  CHECK_THAT(msg, Catch::Contains("map.hdr: Radiance HDR images are not supported"));
+  const std::string exr = std::string("\x76\x2f\x31\x01", 4) + std::string(64, '\0');
+  msg = error_of([&] {
+    (void)mppi::CostMap::decode_image(reinterpret_cast<const std::uint8_t*>(exr.data()), exr.size(), "map.exr", spec);
+  });
+  CHECK_THAT(msg, Catch::Contains("map.exr: OpenEXR images are not supported"));
+  // A file that is not there.
+  msg = error_of([&] { (void)mppi::CostMap::load_image(dir + "no_such_map.png", spec); });
+  CHECK_THAT(msg, Catch::Contains("no_such_map.png: cannot open image file"));
 }
