@@ -185,7 +185,7 @@ TEST_CASE("autorally-bf: the Vulkan backend's costs equal the CPU backend's", "[
 }
 
 TEST_CASE("autorally-bf drives 3 laps of the Gazebo oval without a crash, on the CPU and on Vulkan",
-          "[autorally_bf][closed_loop]") {
+          "[autorally_bf][closed_loop][slow]") {
   for (const auto backend : {mppi::BackendChoice::kCpu, mppi::BackendChoice::kVulkan}) {
     mppi::sim::ClosedLoopConfig c;
     c.model = mppi::models::AutoRallyBasisFunctions::kName;

@@ -180,7 +180,7 @@ TEST_CASE("diagnosis from a double-track nominal names a steering delay; nothing
   check_other_nominal("double-track", "");
 }
 
-TEST_CASE("diagnosis from a full-vehicle nominal names aerodynamic drag", "[diagnose][other_models]") {
+TEST_CASE("diagnosis from a full-vehicle nominal names aerodynamic drag", "[diagnose][other_models][slow]") {
   check_other_nominal("full-vehicle", "aero_drag_kgpm=0.5");
 }
 
@@ -188,7 +188,7 @@ TEST_CASE("diagnosis from a kinematic nominal names a steering gain", "[diagnose
   check_other_nominal("kinematic", "steer_gain=0.75");
 }
 
-TEST_CASE("diagnosis from a network nominal names a throttle lag", "[diagnose][other_models]") {
+TEST_CASE("diagnosis from a network nominal names a throttle lag", "[diagnose][other_models][slow]") {
   check_other_nominal("autorally-nn", "throttle_lag_s=0.2");
 }
 

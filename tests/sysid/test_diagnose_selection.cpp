@@ -63,23 +63,23 @@ static void check_named_alone(const char* truth) {
   }
 }
 
-TEST_CASE("seed x effect sweep: a steering delay is named alone and held-out error halves", "[diagnose]") {
+TEST_CASE("seed x effect sweep: a steering delay is named alone and held-out error halves", "[diagnose][slow]") {
   check_named_alone("steer_delay_s=0.08");
 }
 
-TEST_CASE("seed x effect sweep: aerodynamic drag is named alone and held-out error halves", "[diagnose]") {
+TEST_CASE("seed x effect sweep: aerodynamic drag is named alone and held-out error halves", "[diagnose][slow]") {
   check_named_alone("aero_drag_kgpm=0.4");
 }
 
-TEST_CASE("seed x effect sweep: a grip change is named alone and held-out error halves", "[diagnose]") {
+TEST_CASE("seed x effect sweep: a grip change is named alone and held-out error halves", "[diagnose][slow]") {
   check_named_alone("grip_change_time_s=12,grip_scale=0.6");
 }
 
-TEST_CASE("seed x effect sweep: a throttle lag is named alone and held-out error halves", "[diagnose]") {
+TEST_CASE("seed x effect sweep: a throttle lag is named alone and held-out error halves", "[diagnose][slow]") {
   check_named_alone("throttle_lag_s=0.25");
 }
 
-TEST_CASE("seed x effect sweep: a steering offset is named alone and held-out error halves", "[diagnose]") {
+TEST_CASE("seed x effect sweep: a steering offset is named alone and held-out error halves", "[diagnose][slow]") {
   check_named_alone("steer_offset=0.08");
 }
 
@@ -264,7 +264,7 @@ sim::Recording circles_over_a_patch(std::uint64_t seed, double duration_s) {
 
 }  // namespace
 
-TEST_CASE("a patch of low grip is named as a place, not as a change in time", "[diagnose]") {
+TEST_CASE("a patch of low grip is named as a place, not as a change in time", "[diagnose][slow]") {
   const DiagData d = prepare(circles_over_a_patch(11, 60.0), "circles over a patch");
   DiagnoseOptions o;
   o.plots = false;
