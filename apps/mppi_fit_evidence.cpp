@@ -23,8 +23,10 @@ using namespace mppi;
 const char* kEvidenceUsage = R"(usage:
   mppi-fit diagnose synth --generator independent --out FILE.csv [--effect key=value,...] [--seed N]
         [--duration S] [--track gazebo|marietta|ccrf] [--direction ccw|cw] [--driver pursuit|human]
-        [--speed-range MIN:MAX] [--noise-scale F] [--glitch-rate P] [--drop-rate P]
-        writes FILE.csv, FILE.clean.csv (noise-free), FILE.truth.json (effects, sizes, table ids)
+        [--speed-range MIN:MAX] [--noise-scale F] [--glitch-rate P] [--drop-rate P] [--vehicle FILE.yaml]
+        writes FILE.csv, FILE.clean.csv (noise-free), FILE.truth.json (effects, sizes, table ids);
+        the car has the constants of --vehicle (default data/config/autorally_single_track.yaml):
+        diagnose against the same file (mppi-fit diagnose --params FILE.yaml)
   mppi-fit diagnose sweep --generator independent [--reduced] [--seeds N] [--sizes small,large]
         [--effects A,B] [--pairs N] [--clean N] [--duration S] [--jobs N] [--out DIR] [--md FILE]
         [--summarize DIR]  (only the table, from DIR/runs.jsonl of a sweep, finished or not)
@@ -89,6 +91,7 @@ int evidence_synth(int argc, char** argv) {
     } else if (f == "--noise-scale") o.noise.scale = number(f, value());
     else if (f == "--glitch-rate") o.noise.glitch_rate = number(f, value());
     else if (f == "--drop-rate") o.noise.drop_rate = number(f, value());
+    else if (f == "--vehicle") o.vehicle_yaml = value();
     else if (f == "--help" || f == "-h") {
       std::fputs(usage().c_str(), stdout);
       return 0;
@@ -98,6 +101,8 @@ int evidence_synth(int argc, char** argv) {
   const auto r = evidence::generate_evidence(o, out);
   std::printf("wrote %s (%d rows; %s, %s, driver %s, crashes %d), %s, %s\n", r.csv.c_str(), r.rows, r.track.c_str(),
               r.direction.c_str(), r.driver.c_str(), r.crashes, r.clean_csv.c_str(), r.truth_json.c_str());
+  std::printf("vehicle constants: %s (the nominal: mppi-fit diagnose --params %s)\n", r.vehicle_yaml.c_str(),
+              r.vehicle_yaml.c_str());
   return 0;
 }
 

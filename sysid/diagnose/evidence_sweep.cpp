@@ -115,7 +115,10 @@ EvidenceRun run_evidence_case(const EvidenceCase& c, const std::string& dir, dou
 
     const DiagData d = load_recording(csv);
     const DiagData clean = load_recording(g.clean_csv);
-    const auto family = make_model_family("single-track");
+    // The nominal is the vehicle file the generator's car was built from: an effect-free
+    // recording then has the nominal physics (computed by other code), as on a real car whose
+    // parameter file is known.
+    const auto family = make_model_family("single-track", g.vehicle_yaml);
     const DiagnoseResult r = run_diagnosis(d, *family, o);
     run.named = r.selection.selected;
     for (const auto& s : r.selection.suspected) run.suspected.push_back(s.id);
