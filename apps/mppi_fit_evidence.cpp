@@ -29,6 +29,7 @@ const char* kEvidenceUsage = R"(usage:
         diagnose against the same file (mppi-fit diagnose --params FILE.yaml)
   mppi-fit diagnose sweep --generator independent [--reduced] [--seeds N] [--sizes small,large]
         [--effects A,B] [--pairs N] [--clean N] [--duration S] [--jobs N] [--out DIR] [--md FILE]
+        [--vehicle FILE.yaml]  (the car's constants, also the diagnosis' nominal)
         [--summarize DIR]  (only the table, from DIR/runs.jsonl of a sweep, finished or not)
         (full grid: 5 seeds, every effect at both sizes, 8 pairs, 20 effect-free; --reduced: 1 seed,
         3 pairs, 4 effect-free). Writes DIR/runs.jsonl, DIR/evidence_sweep.md, DIR/evidence_sweep.json.
@@ -112,7 +113,7 @@ int evidence_sweep(int argc, char** argv) {
   int seeds = -1, pairs = -1, clean = -1, jobs = 1;
   std::vector<std::string> sizes, effects;
   double duration = 60;
-  std::string out = "out/evidence_sweep", md_copy, summarize;
+  std::string out = "out/evidence_sweep", md_copy, summarize, vehicle;
   for (int i = 2; i < argc; ++i) {
     const std::string f = argv[i];
     auto value = [&]() -> std::string {
@@ -129,6 +130,7 @@ int evidence_sweep(int argc, char** argv) {
     else if (f == "--duration") duration = number(f, value());
     else if (f == "--jobs") jobs = std::max(1, static_cast<int>(number(f, value())));
     else if (f == "--out") out = value();
+    else if (f == "--vehicle") vehicle = value();
     else if (f == "--md") md_copy = value();
     else if (f == "--summarize") summarize = value();
     else if (f == "--help" || f == "-h") {
@@ -152,6 +154,7 @@ int evidence_sweep(int argc, char** argv) {
   if (!sizes.empty()) grid.sizes = sizes;
   grid.effects = effects;
   grid.duration_s = duration;
+  grid.vehicle_yaml = vehicle;
   const auto cases = diagnose::evidence_cases(grid);
   std::filesystem::create_directories(out);
   std::ofstream jsonl(out + "/runs.jsonl");
@@ -163,7 +166,7 @@ int evidence_sweep(int argc, char** argv) {
     for (std::size_t k = next++; k < cases.size(); k = next++) {
       diagnose::DiagnoseOptions o;
       o.plots = false;
-      runs[k] = diagnose::run_evidence_case(cases[k], out, grid.duration_s, o);
+      runs[k] = diagnose::run_evidence_case(cases[k], out, grid.duration_s, o, grid.vehicle_yaml);
       const auto& r = runs[k];
       std::lock_guard<std::mutex> lock(io);
       std::string named;

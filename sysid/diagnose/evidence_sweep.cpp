@@ -98,13 +98,14 @@ std::vector<EvidenceCase> evidence_cases(const EvidenceGrid& g) {
 }
 
 EvidenceRun run_evidence_case(const EvidenceCase& c, const std::string& dir, double duration_s,
-                              const DiagnoseOptions& o) {
+                              const DiagnoseOptions& o, const std::string& vehicle_yaml) {
   EvidenceRun run;
   run.c = c;
   try {
     evidence::EvidenceOptions eo;
     eo.seed = static_cast<std::uint64_t>(c.seed);
     eo.duration_s = duration_s;
+    eo.vehicle_yaml = vehicle_yaml;
     eo.truth_names = evidence::set_truth_effects(c.assignments, &eo.truth);
     const std::string csv = dir + "/" + c.label() + ".csv";
     const evidence::EvidenceResult g = evidence::generate_evidence(eo, csv);
