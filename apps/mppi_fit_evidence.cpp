@@ -23,10 +23,13 @@ using namespace mppi;
 const char* kEvidenceUsage = R"(usage:
   mppi-fit diagnose synth --generator independent --out FILE.csv [--effect key=value,...] [--seed N]
         [--duration S] [--track gazebo|marietta|ccrf] [--direction ccw|cw] [--driver pursuit|human]
-        [--speed-range MIN:MAX] [--noise-scale F] [--glitch-rate P] [--drop-rate P]
-        writes FILE.csv, FILE.clean.csv (noise-free), FILE.truth.json (effects, sizes, table ids)
+        [--speed-range MIN:MAX] [--noise-scale F] [--glitch-rate P] [--drop-rate P] [--vehicle FILE.yaml]
+        writes FILE.csv, FILE.clean.csv (noise-free), FILE.truth.json (effects, sizes, table ids);
+        the car has the constants of --vehicle (default data/config/autorally_single_track.yaml):
+        diagnose against the same file (mppi-fit diagnose --params FILE.yaml)
   mppi-fit diagnose sweep --generator independent [--reduced] [--seeds N] [--sizes small,large]
         [--effects A,B] [--pairs N] [--clean N] [--duration S] [--jobs N] [--out DIR] [--md FILE]
+        [--vehicle FILE.yaml]  (the car's constants, also the diagnosis' nominal)
         [--summarize DIR]  (only the table, from DIR/runs.jsonl of a sweep, finished or not)
         (full grid: 5 seeds, every effect at both sizes, 8 pairs, 20 effect-free; --reduced: 1 seed,
         3 pairs, 4 effect-free). Writes DIR/runs.jsonl, DIR/evidence_sweep.md, DIR/evidence_sweep.json.
@@ -89,6 +92,7 @@ int evidence_synth(int argc, char** argv) {
     } else if (f == "--noise-scale") o.noise.scale = number(f, value());
     else if (f == "--glitch-rate") o.noise.glitch_rate = number(f, value());
     else if (f == "--drop-rate") o.noise.drop_rate = number(f, value());
+    else if (f == "--vehicle") o.vehicle_yaml = value();
     else if (f == "--help" || f == "-h") {
       std::fputs(usage().c_str(), stdout);
       return 0;
@@ -98,6 +102,8 @@ int evidence_synth(int argc, char** argv) {
   const auto r = evidence::generate_evidence(o, out);
   std::printf("wrote %s (%d rows; %s, %s, driver %s, crashes %d), %s, %s\n", r.csv.c_str(), r.rows, r.track.c_str(),
               r.direction.c_str(), r.driver.c_str(), r.crashes, r.clean_csv.c_str(), r.truth_json.c_str());
+  std::printf("vehicle constants: %s (the nominal: mppi-fit diagnose --params %s)\n", r.vehicle_yaml.c_str(),
+              r.vehicle_yaml.c_str());
   return 0;
 }
 
@@ -107,7 +113,7 @@ int evidence_sweep(int argc, char** argv) {
   int seeds = -1, pairs = -1, clean = -1, jobs = 1;
   std::vector<std::string> sizes, effects;
   double duration = 60;
-  std::string out = "out/evidence_sweep", md_copy, summarize;
+  std::string out = "out/evidence_sweep", md_copy, summarize, vehicle;
   for (int i = 2; i < argc; ++i) {
     const std::string f = argv[i];
     auto value = [&]() -> std::string {
@@ -124,6 +130,7 @@ int evidence_sweep(int argc, char** argv) {
     else if (f == "--duration") duration = number(f, value());
     else if (f == "--jobs") jobs = std::max(1, static_cast<int>(number(f, value())));
     else if (f == "--out") out = value();
+    else if (f == "--vehicle") vehicle = value();
     else if (f == "--md") md_copy = value();
     else if (f == "--summarize") summarize = value();
     else if (f == "--help" || f == "-h") {
@@ -147,6 +154,7 @@ int evidence_sweep(int argc, char** argv) {
   if (!sizes.empty()) grid.sizes = sizes;
   grid.effects = effects;
   grid.duration_s = duration;
+  grid.vehicle_yaml = vehicle;
   const auto cases = diagnose::evidence_cases(grid);
   std::filesystem::create_directories(out);
   std::ofstream jsonl(out + "/runs.jsonl");
@@ -158,7 +166,7 @@ int evidence_sweep(int argc, char** argv) {
     for (std::size_t k = next++; k < cases.size(); k = next++) {
       diagnose::DiagnoseOptions o;
       o.plots = false;
-      runs[k] = diagnose::run_evidence_case(cases[k], out, grid.duration_s, o);
+      runs[k] = diagnose::run_evidence_case(cases[k], out, grid.duration_s, o, grid.vehicle_yaml);
       const auto& r = runs[k];
       std::lock_guard<std::mutex> lock(io);
       std::string named;

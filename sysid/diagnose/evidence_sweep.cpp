@@ -98,13 +98,14 @@ std::vector<EvidenceCase> evidence_cases(const EvidenceGrid& g) {
 }
 
 EvidenceRun run_evidence_case(const EvidenceCase& c, const std::string& dir, double duration_s,
-                              const DiagnoseOptions& o) {
+                              const DiagnoseOptions& o, const std::string& vehicle_yaml) {
   EvidenceRun run;
   run.c = c;
   try {
     evidence::EvidenceOptions eo;
     eo.seed = static_cast<std::uint64_t>(c.seed);
     eo.duration_s = duration_s;
+    eo.vehicle_yaml = vehicle_yaml;
     eo.truth_names = evidence::set_truth_effects(c.assignments, &eo.truth);
     const std::string csv = dir + "/" + c.label() + ".csv";
     const evidence::EvidenceResult g = evidence::generate_evidence(eo, csv);
@@ -115,7 +116,10 @@ EvidenceRun run_evidence_case(const EvidenceCase& c, const std::string& dir, dou
 
     const DiagData d = load_recording(csv);
     const DiagData clean = load_recording(g.clean_csv);
-    const auto family = make_model_family("single-track");
+    // The nominal is the vehicle file the generator's car was built from: an effect-free
+    // recording then has the nominal physics (computed by other code), as on a real car whose
+    // parameter file is known.
+    const auto family = make_model_family("single-track", g.vehicle_yaml);
     const DiagnoseResult r = run_diagnosis(d, *family, o);
     run.named = r.selection.selected;
     for (const auto& s : r.selection.suspected) run.suspected.push_back(s.id);

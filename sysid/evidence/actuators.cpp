@@ -29,7 +29,7 @@ double backlash(double output, double input, double width) {
 
 double Battery::torque_Nm(const CarConstants& c, double throttle, double rear_rim_mps) const {
   const double back_emf = rear_rim_mps / c.no_load_speed_mps;
-  if (throttle <= 0) return c.stall_torque_Nm * (throttle - back_emf);
+  if (throttle <= 0) return c.stall_torque_Nm * (c.brake_torque_ratio * throttle - back_emf);
   const double open_circuit = std::max(0.0, 1 - capacity_sag * charge_used / 60.0);
   const double t = c.stall_torque_Nm * (throttle * open_circuit - back_emf);
   // With I = torque / stall torque x I_stall and V = V_oc - R I: t (1 + a u) = stall (u v_oc - emf).

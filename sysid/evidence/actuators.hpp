@@ -33,7 +33,8 @@ double backlash(double output, double input, double width);
 
 // The DC motor behind a battery: torque = stall (u V / V_nom - omega R / v_0) for u >= 0 with
 // V = V_oc(q) - R I, I proportional to the torque (solved in closed form); braking (u < 0)
-// is the plain line. `charge_used` [stall-current seconds] grows with the current.
+// is the plain line with the command scaled: stall (brake_torque_ratio u - omega R / v_0).
+// `charge_used` [stall-current seconds] grows with the current.
 struct Battery {
   double internal_resistance_fraction = 0, capacity_sag = 0, charge_used = 0;
   double torque_Nm(const CarConstants& c, double throttle, double rear_rim_mps) const;

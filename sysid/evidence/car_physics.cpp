@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -25,31 +28,44 @@ CarConstants read_car_constants(const std::string& yaml_path) {
       throw Error(yaml_path + ": " + key + ": expected a number");
     }
   };
-  take(root, "mass_kg", &c.mass_kg);
-  take(root, "yaw_inertia_kgm2", &c.yaw_inertia_kgm2);
-  take(root, "cg_to_front_axle_m", &c.lf_m);
-  take(root, "cg_to_rear_axle_m", &c.lr_m);
-  take(root, "cg_height_m", &c.cg_height_m);
-  take(root, "wheel_radius_m", &c.wheel_radius_m);
-  take(root, "front_wheel_inertia_kgm2", &c.front_wheel_inertia_kgm2);
-  take(root, "rear_wheel_inertia_kgm2", &c.rear_wheel_inertia_kgm2);
-  take(root, "gravity_mps2", &c.gravity_mps2);
-  take(root, "max_steer_rad", &c.max_steer_rad);
-  take(root, "stall_torque_Nm", &c.stall_torque_Nm);
-  take(root, "no_load_speed_mps", &c.no_load_speed_mps);
-  take(root, "rolling_resistance", &c.rolling_coefficient);
-  take(root, "rolling_resistance_speed_mps", &c.rolling_speed_mps);
-  take(root, "aero_drag_kgpm", &c.aero_drag_kgpm);
-  take(root, "slip_speed_floor_mps", &c.slip_floor_mps);
-  take(root, "slip_blend", &c.slip_blend);
-  if (const YAML::Node t = root["tyre"]) {
-    take(t, "B", &c.mf_B);
-    take(t, "C", &c.mf_C);
-    take(t, "D", &c.mf_D);
-    take(t, "E", &c.mf_E);
-    take(t, "Sh", &c.mf_Sh);
-    take(t, "Sv", &c.mf_Sv);
-  }
+  // Every key this car knows, with where it goes; any other key is an error.
+  const std::vector<std::pair<const char*, double*>> top = {
+      {"mass_kg", &c.mass_kg},
+      {"yaw_inertia_kgm2", &c.yaw_inertia_kgm2},
+      {"cg_to_front_axle_m", &c.lf_m},
+      {"cg_to_rear_axle_m", &c.lr_m},
+      {"cg_height_m", &c.cg_height_m},
+      {"wheel_radius_m", &c.wheel_radius_m},
+      {"front_wheel_inertia_kgm2", &c.front_wheel_inertia_kgm2},
+      {"rear_wheel_inertia_kgm2", &c.rear_wheel_inertia_kgm2},
+      {"gravity_mps2", &c.gravity_mps2},
+      {"max_steer_rad", &c.max_steer_rad},
+      {"stall_torque_Nm", &c.stall_torque_Nm},
+      {"no_load_speed_mps", &c.no_load_speed_mps},
+      {"brake_torque_ratio", &c.brake_torque_ratio},
+      {"rolling_resistance", &c.rolling_coefficient},
+      {"rolling_resistance_speed_mps", &c.rolling_speed_mps},
+      {"aero_drag_kgpm", &c.aero_drag_kgpm},
+      {"slip_speed_floor_mps", &c.slip_floor_mps},
+      {"slip_blend", &c.slip_blend},
+  };
+  const std::vector<std::pair<const char*, double*>> tyre = {
+      {"B", &c.mf_B}, {"C", &c.mf_C}, {"D", &c.mf_D}, {"E", &c.mf_E}, {"Sh", &c.mf_Sh}, {"Sv", &c.mf_Sv},
+  };
+  auto read_all = [&](const YAML::Node& n, const std::vector<std::pair<const char*, double*>>& keys,
+                      const std::string& where) {
+    if (!n.IsMap()) throw Error(yaml_path + ": " + (where.empty() ? "the file" : where) + ": expected a map of keys");
+    for (const auto& kv : n) {
+      const std::string key = kv.first.as<std::string>();
+      if (where.empty() && key == "tyre") continue;
+      if (std::none_of(keys.begin(), keys.end(), [&](const auto& k) { return key == k.first; }))
+        throw Error(yaml_path + ": " + where + (where.empty() ? "" : ".") + key +
+                    ": unknown vehicle constant (the evidence car does not model it)");
+    }
+    for (const auto& [key, member] : keys) take(n, key, member);
+  };
+  read_all(root, top, "");
+  if (const YAML::Node t = root["tyre"]) read_all(t, tyre, "tyre");
   return c;
 }
 

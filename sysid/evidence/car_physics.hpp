@@ -17,12 +17,15 @@ struct CarConstants {
   double front_wheel_inertia_kgm2 = 0.048, rear_wheel_inertia_kgm2 = 0.044, gravity_mps2 = 9.81;
   double mf_B = 1.1559, mf_C = 1.1924, mf_D = 0.9956, mf_E = -0.8505, mf_Sh = -0.0540, mf_Sv = 0.1444;
   double max_steer_rad = 0.38, stall_torque_Nm = 10.0, no_load_speed_mps = 30.0;
+  double brake_torque_ratio = 1.0;  // torque at throttle -1 (braking) / stall torque
   double rolling_coefficient = 0.05, rolling_speed_mps = 0.5, aero_drag_kgpm = 0.05;
   double slip_floor_mps = 3.0, slip_blend = 0.1;
 };
 
-// Reads the keys it knows of a single-track vehicle YAML (yaml-cpp); others keep the defaults.
-// Throws mppi::Error naming the file for an unreadable file or a non-numeric value.
+// Reads a single-track vehicle YAML (yaml-cpp); keys not given keep the defaults. Throws
+// mppi::Error naming the file for an unreadable file, a non-numeric value or a key it does not
+// know (a constant the nominal model has and this car lacked would make every recording differ
+// from the nominal, effect or not).
 CarConstants read_car_constants(const std::string& yaml_path);
 
 // x, y, yaw, vx, vy, yaw rate, front and rear wheel speeds [rad/s].

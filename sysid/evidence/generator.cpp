@@ -88,8 +88,8 @@ EvidenceResult generate_evidence(const EvidenceOptions& o, const std::string& cs
   const sim::Track ccw = sim::Track::load(res.track);
   const Ground ground = make_ground(o.truth, ccw, o.seed);
   const sim::CrashDetector crashes(track);
-  const CarConstants car = read_car_constants(
-      o.vehicle_yaml.empty() ? sim::data_file("config/autorally_single_track.yaml") : o.vehicle_yaml);
+  res.vehicle_yaml = o.vehicle_yaml.empty() ? sim::data_file("config/autorally_single_track.yaml") : o.vehicle_yaml;
+  const CarConstants car = read_car_constants(res.vehicle_yaml);
   Driver driver(res.driver, track, o.seed, o.speed_min_mps, o.speed_max_mps, car.lf_m + car.lr_m, car.max_steer_rad);
   ActuatorChain chain(o.truth, car);
 
@@ -229,6 +229,7 @@ EvidenceResult generate_evidence(const EvidenceOptions& o, const std::string& cs
   j["direction"] = res.direction;
   j["driver"] = res.driver;
   j["duration_s"] = o.duration_s;
+  j["vehicle_params"] = res.vehicle_yaml;  // an effect-free recording has these constants: the nominal
   j["crashes"] = res.crashes;
   j["noise"] = {{"position_m", o.noise.position_m * o.noise.scale}, {"yaw_rad", o.noise.yaw_rad * o.noise.scale},
                 {"vx_mps", o.noise.vx_mps * o.noise.scale}, {"vy_mps", o.noise.vy_mps * o.noise.scale},

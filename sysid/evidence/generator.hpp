@@ -8,7 +8,8 @@
 //   FILE.clean.csv  the same rows without noise and glitches (sensor faults kept: they are
 //                   what the sensors show, not noise)
 //   FILE.truth.json the effects, their sizes and forms, and the effect-table ids a diagnosis may
-//                   name for each ("out of library" where none exists)
+//                   name for each ("out of library" where none exists); the vehicle file whose
+//                   constants the car has (`vehicle_params`: the nominal to diagnose against)
 // It shares no code with the diagnosis' candidate terms or their effect table (docs/EVIDENCE.md;
 // a test checks its includes).
 #include <cstdint>
@@ -42,6 +43,7 @@ struct EvidenceOptions {
 
 struct EvidenceResult {
   std::string csv, clean_csv, truth_json, track, direction, driver;
+  std::string vehicle_yaml;  // the vehicle constants read: the nominal a diagnosis should be given
   int crashes = 0, rows = 0;
 };
 

@@ -11,7 +11,13 @@
 #include <random>
 #include <sstream>
 
+#include "dynamics/vehicle_params.hpp"
+#include "mppi/error.hpp"
+#include "sim/data_dir.hpp"
 #include "sim/recording.hpp"
+#include "sysid/diagnose/data.hpp"
+#include "sysid/diagnose/model_family.hpp"
+#include "sysid/diagnose/replay.hpp"
 #include "sysid/evidence/actuators.hpp"
 #include "sysid/evidence/car_physics.hpp"
 #include "sysid/evidence/generator.hpp"
@@ -200,6 +206,59 @@ TEST_CASE("evidence: the battery's motor torque solves its own voltage equation"
   CHECK(b.charge_used == Approx(30 + 0.5 * 2.0));
 }
 
+TEST_CASE("evidence: braking torque is the stall line with the command scaled by brake_torque_ratio", "[evidence]") {
+  CarConstants c;
+  c.brake_torque_ratio = 0.25;
+  Battery b;
+  b.internal_resistance_fraction = 0.3;  // the battery acts on drive, not on braking
+  const double rim = 3.0;
+  CHECK(b.torque_Nm(c, -0.8, rim) == Approx(c.stall_torque_Nm * (0.25 * -0.8 - rim / c.no_load_speed_mps)).epsilon(1e-12));
+  CHECK(b.torque_Nm(c, 0.0, rim) == Approx(-c.stall_torque_Nm * rim / c.no_load_speed_mps).epsilon(1e-12));
+  c.brake_torque_ratio = 1.0;
+  CHECK(b.torque_Nm(c, -0.8, rim) == Approx(c.stall_torque_Nm * (-0.8 - rim / c.no_load_speed_mps)).epsilon(1e-12));
+}
+
+TEST_CASE("evidence: the car reads every constant of the nominal vehicle file and refuses keys it does not model", "[evidence]") {
+  // The project's loader of the same file is the oracle: an effect-free evidence car must have
+  // the nominal's constants, all of them.
+  const std::string shipped = test::data_path("config/autorally_single_track.yaml");
+  const SingleTrackParams p = load_single_track_params(shipped);
+  const CarConstants c = read_car_constants(shipped);
+  CHECK(c.mass_kg == p.mass_kg);
+  CHECK(c.stall_torque_Nm == p.stall_torque_Nm);
+  CHECK(c.no_load_speed_mps == p.no_load_speed_mps);
+  CHECK(c.brake_torque_ratio == p.brake_torque_ratio);
+  CHECK(c.max_steer_rad == p.max_steer_rad);
+  CHECK(c.rolling_coefficient == p.rolling_resistance);
+  CHECK(c.aero_drag_kgpm == p.aero_drag_kgpm);
+  CHECK(c.mf_B == p.tyre.B);
+  CHECK(c.mf_Sv == p.tyre.Sv);
+
+  // Every key of the single-track parameter table, with a value of its own: none is refused.
+  const std::string dir = (std::filesystem::temp_directory_path() / "mppi_evidence_keys_test").string();
+  std::filesystem::create_directories(dir);
+  SingleTrackParams q;
+  std::ostringstream top, tyre;
+  int k = 0;
+  for (const ParamField& f : param_table(q)) {
+    const std::string key = f.key;
+    const double v = 0.5 + 0.01 * ++k;
+    if (key.rfind("tyre.", 0) == 0)
+      tyre << "  " << key.substr(5) << ": " << v << "\n";
+    else
+      top << key << ": " << v << "\n";
+  }
+  const std::string all = dir + "/all.yaml";
+  std::ofstream(all) << top.str() << "tyre:\n" << tyre.str();
+  const CarConstants every = read_car_constants(all);
+  CHECK(every.brake_torque_ratio != CarConstants{}.brake_torque_ratio);
+
+  const std::string unknown = dir + "/unknown.yaml";
+  std::ofstream(unknown) << "mass_kg: 20\nclutch_slip: 0.1\n";
+  CHECK_THROWS_WITH(read_car_constants(unknown), Catch::Contains(unknown) && Catch::Contains("clutch_slip"));
+  std::filesystem::remove_all(dir);
+}
+
 TEST_CASE("evidence: recordings are reproducible by seed and differ between seeds", "[evidence]") {
   const std::string dir = (std::filesystem::temp_directory_path() / "mppi_evidence_test").string();
   std::filesystem::remove_all(dir);
@@ -224,6 +283,31 @@ TEST_CASE("evidence: recordings are reproducible by seed and differ between seed
   const std::string truth = slurp(a.truth_json);
   CHECK(truth.find("\"steer_delay\"") != std::string::npos);
   CHECK(truth.find("\"grip_patch\"") != std::string::npos);  // the grip patches: a place-dependent candidate
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("evidence: an effect-free recording is predicted by the nominal built from the vehicle file it names", "[evidence]") {
+  // The nominal single-track (other code, another integrator) built from the file in the truth
+  // file predicts the car's noise-free states for 1 s about as well as its own noise allows; the
+  // library defaults, a different car since the shipped file was calibrated, do not.
+  const std::string dir = (std::filesystem::temp_directory_path() / "mppi_evidence_nominal_test").string();
+  std::filesystem::remove_all(dir);
+  EvidenceOptions o;
+  o.duration_s = 20;
+  o.seed = 3;
+  const EvidenceResult r = generate_evidence(o, dir + "/clean.csv");
+  CHECK(r.vehicle_yaml == o.vehicle_yaml + sim::data_file("config/autorally_single_track.yaml"));
+  CHECK(slurp(r.truth_json).find("\"vehicle_params\"") != std::string::npos);
+  const diagnose::DiagData d = diagnose::load_recording(r.clean_csv);
+  const std::vector<char> all(d.rows(), 1);
+  auto nrmse_1s = [&](const std::string& params) {
+    const auto family = diagnose::make_model_family("single-track", params);
+    return diagnose::horizon_metrics(*family->make({}), d, all, {1.0}, 5, {})[0].normalized_rmse;
+  };
+  const double same = nrmse_1s(r.vehicle_yaml), defaults = nrmse_1s("");
+  INFO("1-s normalised RMSE: nominal from " << r.vehicle_yaml << " " << same << ", library defaults " << defaults);
+  CHECK(same < 0.1);
+  CHECK(defaults > 3 * same);
   std::filesystem::remove_all(dir);
 }
 
