@@ -10,6 +10,21 @@
 #include "mppi/error.hpp"
 
 namespace mppi::diagnose {
+
+std::size_t used_param_count(const EffectSpec& spec, const FitResult& fit) {
+  const EffectParams defaults;
+  std::size_t used = 0;
+  for (std::size_t j = 0; j < spec.params.size(); ++j) {
+    if (static_cast<int>(j) < grid_param_count(spec.data_grid) || j >= fit.params.size()) {
+      ++used;
+      continue;
+    }
+    const double off = defaults.*(spec.params[j].member);
+    const ParamEstimate& p = fit.params[j];
+    if (!(p.stddev > 0) || std::abs(p.value - off) > 2.0 * p.stddev) ++used;
+  }
+  return std::max<std::size_t>(used, 1);
+}
 std::unique_ptr<ReplayModel> make_member_or_null(const ModelFamily& family, const EffectParams& e) {
   try {
     return family.make(e);

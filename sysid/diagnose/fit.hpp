@@ -42,6 +42,12 @@ struct FitResult {
   int iterations = 0;
 };
 
+// Parameters of a fitted candidate that the data use (at least 1): a parameter within two
+// standard deviations of its default (where it is off) is one the fit could leave out, so it
+// does not count against the candidate's simplicity (F0 + b v with b ~ 0 is as simple as
+// c v^2). Parameters searched over the data (a time, a place) always count.
+std::size_t used_param_count(const EffectSpec& spec, const FitResult& fit);
+
 // Fits the free parameters `free` starting from `base` (whose other fields stay fixed).
 FitResult fit_params(const FitProblem& p, const EffectParams& base, const std::vector<ParamSpec>& free,
                      int max_iterations = 15);

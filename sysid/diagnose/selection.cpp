@@ -19,25 +19,6 @@ double heldout_1s_normalized_rmse(const ReplayModel& m, const DiagData& d, const
   return horizon_metrics(m, d, mask, {1.0}, 5, o)[0].normalized_rmse;
 }
 
-// Parameters of a fitted candidate that the data use: a parameter within two standard deviations
-// of its default (where it is off) is one the fit could leave out, so it does not count against
-// the candidate's simplicity (F0 + b v with b ~ 0 is as simple as c v^2). Parameters searched
-// over the data (a time, a place) always count.
-std::size_t used_params(const EffectSpec& spec, const FitResult& fit) {
-  const EffectParams defaults;
-  std::size_t used = 0;
-  for (std::size_t j = 0; j < spec.params.size(); ++j) {
-    if (static_cast<int>(j) < grid_param_count(spec.data_grid) || j >= fit.params.size()) {
-      ++used;
-      continue;
-    }
-    const double off = defaults.*(spec.params[j].member);
-    const ParamEstimate& p = fit.params[j];
-    if (!(p.stddev > 0) || std::abs(p.value - off) > 2.0 * p.stddev) ++used;
-  }
-  return std::max<std::size_t>(used, 1);
-}
-
 struct CandidateFit {
   int index = -1;  // into the candidate list
   FitResult fit;
@@ -98,7 +79,7 @@ GreedyResult greedy(const FitProblem& fit, const FitProblem& val, const std::vec
               [](const CandidateFit* a, const CandidateFit* b) { return a->improvement > b->improvement; });
     if (!order.empty()) {
       const double near_best = opt.parsimony_share * order.front()->improvement;
-      auto params_of = [&](const CandidateFit* c) { return used_params(*cands[static_cast<std::size_t>(c->index)], c->fit); };
+      auto params_of = [&](const CandidateFit* c) { return used_param_count(*cands[static_cast<std::size_t>(c->index)], c->fit); };
       std::stable_sort(order.begin(), order.end(), [&](const CandidateFit* a, const CandidateFit* b) {
         const bool na = a->improvement >= near_best, nb = b->improvement >= near_best;
         if (na != nb) return na;

@@ -289,3 +289,27 @@ TEST_CASE("a patch of low grip is named as a place, not as a change in time", "[
   CHECK_FALSE(at_a_place(r.remaining));
   CHECK(r.explained_share[2] > 0.3);  // yaw rate: the grip shows in the turns
 }
+
+TEST_CASE("simplicity counts only the parameters a fit moved off their default", "[diagnose]") {
+  using mppi::diagnose::FitResult;
+  using mppi::diagnose::ParamEstimate;
+  auto fit_of = [](std::vector<std::pair<double, double>> value_sd) {
+    FitResult f;
+    for (const auto& [v, sd] : value_sd) f.params.push_back(ParamEstimate{"p", "", v, sd});
+    return f;
+  };
+  // rolling_resistance: F0 [N] and b [N s/m], both off at 0.
+  const auto& rolling = mppi::effect_spec("rolling_resistance");
+  REQUIRE(rolling.params.size() == 2);
+  CHECK(mppi::diagnose::used_param_count(rolling, fit_of({{5.0, 1.0}, {0.1, 0.2}})) == 1);  // b within 2 sd of 0
+  CHECK(mppi::diagnose::used_param_count(rolling, fit_of({{5.0, 1.0}, {3.0, 0.5}})) == 2);
+  CHECK(mppi::diagnose::used_param_count(rolling, fit_of({{-2.5, 1.0}, {0.0, 0.0}})) == 2);  // no sd: counts
+  CHECK(mppi::diagnose::used_param_count(rolling, fit_of({{0.1, 1.0}, {0.1, 1.0}})) == 1);  // at least one
+  // grip_patch: its place (x, y) is searched over the data and always counts.
+  const auto& patch = mppi::effect_spec("grip_patch");
+  REQUIRE(patch.params.size() >= 3);
+  std::vector<std::pair<double, double>> at_default;
+  const mppi::EffectParams defaults;
+  for (const auto& p : patch.params) at_default.emplace_back(defaults.*(p.member), 1.0);
+  CHECK(mppi::diagnose::used_param_count(patch, fit_of(at_default)) == 2);
+}
