@@ -18,22 +18,20 @@
 
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 namespace {
 
-// The "library_path" value of a Vulkan driver manifest (JSON), or "" when there is none.
+// ICD.library_path of a Vulkan driver manifest, or "" when the file has none.
 std::string manifest_library_path(const std::filesystem::path& manifest) {
   std::ifstream in(manifest);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string key = "\"library_path\"";
-  std::size_t at = text.find(key);
-  if (at == std::string::npos) return "";
-  at = text.find('"', text.find(':', at + key.size()));
-  const std::size_t end = at == std::string::npos ? at : text.find('"', at + 1);
-  if (end == std::string::npos) return "";
-  return text.substr(at + 1, end - at - 1);
+  const auto json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (!json.is_object() || !json.contains("ICD") || !json["ICD"].is_object()) return "";
+  const auto& icd = json["ICD"];
+  return icd.contains("library_path") && icd["library_path"].is_string() ? icd["library_path"].get<std::string>()
+                                                                         : std::string();
 }
 
 struct KeepVulkanDriversLoaded {
