@@ -60,6 +60,21 @@ class Backend {
   virtual void iterate(const IterationInput& /*in*/, IterationOutput& /*out*/) {}
   // The controls sampled by the last iterate() (T x nu x padded), if the backend keeps them.
   virtual std::span<const float> sampled_controls() const { return {}; }
+  // The controls the last iterate() sampled for samples[j] (each in [0, num_samples)):
+  // out[(t * nu + c) * n + j], n = samples.size(). False (out unspecified) if the backend keeps
+  // none, a sample is out of range or out is too small.
+  virtual bool copy_sampled_controls(std::span<const int> samples, std::span<float> out) const {
+    const std::span<const float> all = sampled_controls();
+    const RolloutShape& s = shape();
+    const std::size_t padded = static_cast<std::size_t>(s.padded_samples), n = samples.size();
+    const std::size_t rows = static_cast<std::size_t>(s.horizon) * static_cast<std::size_t>(s.num_controls);
+    if (all.size() < rows * padded || out.size() < rows * n) return false;
+    for (int k : samples)
+      if (k < 0 || k >= s.num_samples) return false;
+    for (std::size_t r = 0; r < rows; ++r)
+      for (std::size_t j = 0; j < n; ++j) out[r * n + j] = all[r * padded + static_cast<std::size_t>(samples[j])];
+    return true;
+  }
 
   // The cost changed while the controller runs (between iterations, from the thread that
   // steps it): one parameter by its key, or the cost map. False with the reason in *why if

@@ -220,6 +220,20 @@ class Controller {
   std::span<const float> sampled_controls() const {
     return backend_->has_iterate() ? backend_->sampled_controls() : std::span<const float>(controls_);
   }
+  // A few samples' sequences of the last iteration: out[(t * nu + c) * n + j] for samples[j]
+  // (n = samples.size(), each in [0, num_samples)). Cheaper than sampled_controls() when the
+  // backend draws them again on demand. False if none are kept or an argument is out of range.
+  bool copy_sampled_controls(std::span<const int> samples, std::span<float> out) const {
+    if (backend_->has_iterate()) return backend_->copy_sampled_controls(samples, out);
+    const std::size_t padded = static_cast<std::size_t>(backend_->shape().padded_samples), n = samples.size();
+    const std::size_t rows = nominal_.size();
+    if (controls_.size() < rows * padded || out.size() < rows * n) return false;
+    for (int k : samples)
+      if (k < 0 || k >= options_.num_samples) return false;
+    for (std::size_t r = 0; r < rows; ++r)
+      for (std::size_t j = 0; j < n; ++j) out[r * n + j] = controls_[r * padded + static_cast<std::size_t>(samples[j])];
+    return true;
+  }
   std::span<const float> sampled_costs() const { return std::span(costs_).first(options_.num_samples); }
   std::span<const float> weights() const { return std::span(weights_).first(options_.num_samples); }
   const ControllerOptions& options() const { return options_; }

@@ -51,22 +51,6 @@ MPPI_MULTIVERSION void rollout_chunk(const D& model, const C& cost, const float*
   }
 }
 
-// dst[i] = src[i], i in [0, n) (n a multiple of 4, dst on 16 bytes), written past the
-// caches on x86-64 (non-temporal stores: no read of the destination lines, no eviction of the
-// working set); the caller orders them with stream_fence() before another thread reads dst.
-inline void stream_copy(float* dst, const float* src, int n) noexcept {
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  for (int i = 0; i < n; i += 4) _mm_stream_ps(dst + i, _mm_loadu_ps(src + i));
-#else
-  std::memcpy(dst, src, sizeof(float) * static_cast<std::size_t>(n));
-#endif
-}
-inline void stream_fence() noexcept {
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  _mm_sfence();
-#endif
-}
-
 // What iterate_chunk leaves for the combination of the chunks (one cache line per chunk).
 struct alignas(64) ChunkTotals {
   float min_cost = 0.f;   // min of the chunk's finite S_k (+inf if none)
@@ -160,8 +144,9 @@ inline void chunk_partial_sums(const float* e, const float* v, std::size_t padde
 // noise and controls are used while they are in L1: per pair of steps t, t + 1 draw
 // V = clamp(U + eps) for both (sample_step_pair, the numbers of Controller's sampling pass; one
 // Philox call per lane and channel pair serves both steps) into the chunk's own T x nu x kChunk
-// block of `work`, copy them to `controls` (T x nu x padded, kept for the caller) with
-// non-temporal stores, then step the model and cost with each. Then the chunk's share of the
+// block of `work`, then step the model and cost with each. The draws are not kept: writing
+// T x nu x K floats costs 6-8% of the iteration, and a counter-based stream can give any of
+// them again (regenerate_controls). Then the chunk's share of the
 // update, from its own block (in L1/L2), with weights relative to the chunk's own minimum:
 //   e_k = exp(-(S_k - m_c) / lambda),  partial[t * nu + c] = sum_k e_k V_k,t,c
 // (the caller rescales by exp(-(m_c - min S) / lambda): the same weights as the two-pass form,
@@ -169,7 +154,7 @@ inline void chunk_partial_sums(const float* e, const float* v, std::size_t padde
 // work: (D::kNx + T * D::kNu) * kChunk + model scratch floats.
 template <class D, class C>
 MPPI_MULTIVERSION void iterate_chunk(const D& model, const C& cost, const IterationArgs& a,
-                                     int k0, float* work, float* controls, float* costs,
+                                     int k0, float* work, float* costs,
                                      float* expw, float* partial, ChunkTotals* totals) noexcept {
   constexpr int W = kChunk;
   constexpr int Nu = D::kNu;
@@ -180,7 +165,6 @@ MPPI_MULTIVERSION void iterate_chunk(const D& model, const C& cost, const Iterat
   alignas(64) float control_cost[W] = {};
   for (int i = 0; i < D::kNx; ++i) std::fill_n(x + i * W, W, a.x0[i]);
   const float valid_lanes = static_cast<float>(a.num_samples - k0);
-  const std::size_t padded = static_cast<std::size_t>(a.padded);
   for (int t = 0; t < a.horizon; ++t) {
     if (t % 2 == 0) {
       const int steps = std::min(2, a.horizon - t);
@@ -188,8 +172,6 @@ MPPI_MULTIVERSION void iterate_chunk(const D& model, const C& cost, const Iterat
       sample_step_pair<W>(a.key, a.iteration, k0, valid_lanes, t, steps, Nu, a.nominal + t * Nu,
                           a.noise_std, a.lo, a.hi, a.gamma, vt, W, static_cast<std::size_t>(Nu) * W,
                           control_cost);
-      for (int r = 0; r < steps * Nu; ++r)
-        stream_copy(controls + (static_cast<std::size_t>(t) * Nu + r) * padded + k0, vt + r * W, W);
     }
     const float* u = v + static_cast<std::size_t>(t) * Nu * W;
     model.template step<W>(Batch<D::kNx, W>{x}, ConstBatch<Nu, W>{u}, a.dt_s, scratch);
@@ -224,7 +206,21 @@ MPPI_MULTIVERSION void iterate_chunk(const D& model, const C& cost, const Iterat
   *totals = tot;
   // partial sums of e_k V_k, from the chunk's own block (in L1/L2)
   chunk_partial_sums(e, v, W, a.horizon * Nu, partial);
-  stream_fence();
+}
+
+// The controls that iterate_chunk drew for samples [k0, k0 + W), again, bit for bit (the same
+// sample_step_pair on the same inputs, in a clone chosen the same way):
+// v[t * v_step_stride + c * v_stride + j] for sample k0 + j. a.x0 is not read.
+template <int W>
+MPPI_MULTIVERSION void regenerate_controls(const IterationArgs& a, int nu, int k0, float* v,
+                                           std::size_t v_stride, std::size_t v_step_stride) noexcept {
+  alignas(64) float control_cost[W] = {};  // summed as in iterate_chunk, not used
+  const float valid_lanes = static_cast<float>(a.num_samples - k0);
+  for (int t = 0; t < a.horizon; t += 2)
+    sample_step_pair<W>(a.key, a.iteration, k0, valid_lanes, t, std::min(2, a.horizon - t), nu,
+                        a.nominal + t * nu, a.noise_std, a.lo, a.hi, a.gamma,
+                        v + static_cast<std::size_t>(t) * v_step_stride, v_stride, v_step_stride,
+                        control_cost);
 }
 
 // The chunks' shares combined in chunk order (so independent of the thread count): weights
@@ -301,6 +297,11 @@ class CpuBackend final : public Backend {
     const int chunks = shape_.padded_samples / kChunk;
     const std::size_t rows = static_cast<std::size_t>(horizon) * D::kNu;
     controls_ = aligned_floats(rows * static_cast<std::size_t>(shape_.padded_samples));
+    block_ = aligned_floats(rows * kSampleBlock);
+    drawn_nominal_.assign(rows, 0.f);
+    drawn_std_.assign(D::kNu, 0.f);
+    drawn_lo_.assign(D::kNu, 0.f);
+    drawn_hi_.assign(D::kNu, 0.f);
     expw_ = aligned_floats(static_cast<std::size_t>(shape_.padded_samples));
     partial_stride_ = (rows + 15) / 16 * 16;  // a whole number of cache lines per chunk
     partial_ = aligned_floats(partial_stride_ * static_cast<std::size_t>(chunks));
@@ -334,9 +335,9 @@ class CpuBackend final : public Backend {
                                      in.control_min.data(), in.control_max.data(), in.gamma,
                                      1.f / in.lambda, dt_s_, NoiseKey{in.seed}, in.iteration,
                                      shape_.num_samples, padded, shape_.horizon};
+    remember_draw_inputs(in);
     float* work = work_.data();
     const std::size_t work_floats = work_floats_;
-    float* controls = controls_.get();
     float* costs = out.costs.data();
     float* expw = expw_.get();
     float* partial = partial_.get();
@@ -345,16 +346,45 @@ class CpuBackend final : public Backend {
     runner_.run(chunks, 1, [&](int chunk, int slot) {
       const int k0 = chunk * kChunk;
       detail::iterate_chunk(model_, cost_, args, k0,
-                            work + work_floats * static_cast<std::size_t>(slot), controls,
-                            costs + k0, expw + k0, partial + stride * static_cast<std::size_t>(chunk),
+                            work + work_floats * static_cast<std::size_t>(slot), costs + k0, expw + k0, partial + stride * static_cast<std::size_t>(chunk),
                             totals + chunk);
     });
     detail::combine_chunks(totals, partial, stride, chunks, shape_.horizon * D::kNu,
                            shape_.num_samples, 1.f / in.lambda, expw, sums_.data(), scales_.data(), out);
   }
+  // The last iteration's draws are not stored by iterate(); they are drawn again here, bit for
+  // bit, on the first call after it (one noise pass, about half of a cheap model's iteration).
   std::span<const float> sampled_controls() const override {
-    return {controls_.get(), static_cast<std::size_t>(shape_.horizon) * D::kNu *
-                                 static_cast<std::size_t>(shape_.padded_samples)};
+    const std::size_t padded = static_cast<std::size_t>(shape_.padded_samples);
+    if (!controls_fresh_ && drawn_) {
+      const detail::IterationArgs a = drawn_args();
+      for (int k0 = 0; k0 < shape_.padded_samples; k0 += kChunk)
+        detail::regenerate_controls<kChunk>(a, D::kNu, k0, controls_.get() + k0, padded, D::kNu * padded);
+      controls_fresh_ = true;
+    }
+    return {controls_.get(), static_cast<std::size_t>(shape_.horizon) * D::kNu * padded};
+  }
+  // A few samples' draws, in blocks of kSampleBlock lanes (the operator view picks ~20).
+  bool copy_sampled_controls(std::span<const int> samples, std::span<float> out) const override {
+    const std::size_t n = samples.size();
+    const std::size_t rows = static_cast<std::size_t>(shape_.horizon) * D::kNu;
+    if (!drawn_ || out.size() < rows * n) return false;
+    for (int k : samples)
+      if (k < 0 || k >= shape_.num_samples) return false;
+    if (controls_fresh_) return Backend::copy_sampled_controls(samples, out);
+    const detail::IterationArgs a = drawn_args();
+    int block = -1;
+    for (std::size_t j = 0; j < n; ++j) {
+      const int first = samples[j] / kSampleBlock * kSampleBlock;
+      if (first != block) {
+        detail::regenerate_controls<kSampleBlock>(a, D::kNu, first, block_.get(), kSampleBlock,
+                                                  D::kNu * kSampleBlock);
+        block = first;
+      }
+      for (std::size_t r = 0; r < rows; ++r)
+        out[r * n + j] = block_[r * kSampleBlock + static_cast<std::size_t>(samples[j] - first)];
+    }
+    return true;
   }
 
   void rollout(std::span<const float> x0, std::span<const float> controls,
@@ -385,6 +415,27 @@ class CpuBackend final : public Backend {
     return p;
   }
 
+  static constexpr int kSampleBlock = 16;
+
+  // What the draws of the last iterate() depend on besides the key and iteration (its nominal
+  // changes after the update), kept so they can be drawn again.
+  void remember_draw_inputs(const IterationInput& in) {
+    std::copy(in.nominal.begin(), in.nominal.end(), drawn_nominal_.begin());
+    std::copy(in.noise_std.begin(), in.noise_std.end(), drawn_std_.begin());
+    std::copy(in.control_min.begin(), in.control_min.end(), drawn_lo_.begin());
+    std::copy(in.control_max.begin(), in.control_max.end(), drawn_hi_.begin());
+    drawn_gamma_ = in.gamma;
+    drawn_key_ = NoiseKey{in.seed};
+    drawn_iteration_ = in.iteration;
+    drawn_ = true;
+    controls_fresh_ = false;
+  }
+  detail::IterationArgs drawn_args() const {
+    return {nullptr, drawn_nominal_.data(), drawn_std_.data(), drawn_lo_.data(), drawn_hi_.data(),
+            drawn_gamma_, 0.f, dt_s_, drawn_key_, drawn_iteration_, shape_.num_samples,
+            shape_.padded_samples, shape_.horizon};
+  }
+
   D model_;
   C cost_;
   float dt_s_;
@@ -395,7 +446,16 @@ class CpuBackend final : public Backend {
   std::vector<float> work_;  // threads x work_floats_
   // iterate(): the sampled controls (T x nu x padded), e_k per sample, each chunk's partial sums
   // (partial_stride_ floats per chunk) and totals, and the combination's scratch
-  AlignedFloats controls_, expw_, partial_;
+  AlignedFloats expw_, partial_;
+  // sampled_controls(): the last iteration's draws, drawn again on demand (T x nu x padded);
+  // copy_sampled_controls(): one block of kSampleBlock samples (T x nu x kSampleBlock)
+  AlignedFloats controls_, block_;
+  mutable bool controls_fresh_ = false;
+  bool drawn_ = false;
+  std::vector<float> drawn_nominal_, drawn_std_, drawn_lo_, drawn_hi_;
+  float drawn_gamma_ = 0.f;
+  NoiseKey drawn_key_{};
+  std::uint32_t drawn_iteration_ = 0;
   std::size_t partial_stride_ = 0;
   std::vector<detail::ChunkTotals> totals_;
   std::vector<double> sums_, scales_;

@@ -34,6 +34,9 @@ class DeviceLossInjector final : public Backend {
     inner_->iterate(in, out);
   }
   std::span<const float> sampled_controls() const override { return inner_->sampled_controls(); }
+  bool copy_sampled_controls(std::span<const int> samples, std::span<float> out) const override {
+    return inner_->copy_sampled_controls(samples, out);
+  }
   bool set_cost_param(std::string_view key, double value, std::string* why) override {
     if (calls_ > healthy_calls_) throw_lost();
     return inner_->set_cost_param(key, value, why);

@@ -35,28 +35,33 @@ void capture_paths(const Controller& controller, std::span<const float> first_co
   const ControllerOptions& o = controller.options();
   const int nu = static_cast<int>(first_control.size());
   const int horizon = o.horizon;
-  const std::span<const float> sampled = controller.sampled_controls();
   const std::span<const float> all_weights = controller.weights();
   const std::size_t rows = static_cast<std::size_t>(horizon) * nu;
-  const int padded = rows > 0 ? static_cast<int>(sampled.size() / rows) : 0;
   std::array<int, kPathsPerFrame - 1> picked{};
-  const int rollouts = padded >= o.num_samples ? pick_rollouts(all_weights, picked) : 0;
-  const int paths = 1 + rollouts;
+  int rollouts = pick_rollouts(all_weights, picked);
   frame.horizon = horizon;
   frame.nu = nu;
+  // The picked samples' controls first, packed (rows x rollouts), then spread in place to
+  // rows x paths with the plan in column 0: each value moves to a higher index, so copying
+  // from the last one down never overwrites one not yet moved.
+  frame.controls.resize(rows * (1 + static_cast<std::size_t>(rollouts)));  // within the reserved capacity
+  if (rollouts > 0 &&
+      !controller.copy_sampled_controls(std::span<const int>(picked.data(), static_cast<std::size_t>(rollouts)),
+                                        frame.controls))
+    rollouts = 0;  // this backend keeps no samples
+  const int paths = 1 + rollouts;
   frame.paths = paths;
-  frame.controls.resize(rows * paths);  // within the reserved capacity
+  frame.controls.resize(rows * paths);
   frame.weights.resize(static_cast<std::size_t>(paths));
+  float* c = frame.controls.data();
+  for (std::size_t r = rows; r-- > 0;)
+    for (int j = rollouts; j-- > 0;) c[r * paths + 1 + j] = c[r * rollouts + j];
   // The plan this step optimised: its first control was output, the rest is now nominal[0..].
   const std::span<const float> nominal = controller.nominal();
   for (int t = 0; t < horizon; ++t)
-    for (int c = 0; c < nu; ++c) {
-      const float plan = t == 0 ? first_control[c] : nominal[static_cast<std::size_t>(t - 1) * nu + c];
-      float* row = frame.controls.data() + (static_cast<std::size_t>(t) * nu + c) * paths;
-      row[0] = plan;
-      const float* src = sampled.data() + (static_cast<std::size_t>(t) * nu + c) * padded;
-      for (int j = 0; j < rollouts; ++j) row[1 + j] = src[picked[j]];
-    }
+    for (int ch = 0; ch < nu; ++ch)
+      c[(static_cast<std::size_t>(t) * nu + ch) * paths] =
+          t == 0 ? first_control[ch] : nominal[static_cast<std::size_t>(t - 1) * nu + ch];
   frame.weights[0] = std::numeric_limits<float>::quiet_NaN();
   for (int j = 0; j < rollouts; ++j) frame.weights[1 + j] = all_weights[picked[j]];
 }

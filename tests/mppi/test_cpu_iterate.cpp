@@ -4,6 +4,7 @@
 // against a naive double-precision re-computation of the update law from the samples.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -196,4 +197,47 @@ TEST_CASE("a chunk's share of the weighted sum equals a double-precision dot pro
       REQUIRE(portable[r] == Approx(ref).margin(1e-6 * mag));
     }
   }
+}
+
+TEST_CASE("the fused iteration's draws, given again on demand, are the scalar Philox normals it used",
+          "[core][mppi]") {
+  mppi::ControllerOptions o;
+  o.num_samples = 333;  // a partial last chunk and block
+  o.horizon = 13;       // an odd horizon: the last step uses half of a Philox call
+  o.lambda = 0.5f;
+  o.gamma = 0.2f;
+  o.noise_std = {0.7f};
+  o.control_min = {-1.f};
+  o.control_max = {1.5f};
+  o.safe_control = {0.f};
+  o.num_threads = 2;
+  o.seed = 0x1234abcd5678ull;
+  auto controller = mppi::make_cpu_controller(mppi::test::DoubleIntegrator{}, NanAboveCost{}, o);
+  const float x0[2] = {1.f, 0.f};
+  controller.step(x0);
+  // the nominal the second step samples around: the first step's plan, shifted by one
+  const std::vector<float> nominal(controller.nominal().begin(), controller.nominal().end());
+  controller.step(x0);
+  const std::vector<int> samples = {0, 1, 15, 16, 17, 200, 63, 64, 330, 332};  // unsorted, block edges
+  std::vector<float> some(static_cast<std::size_t>(o.horizon) * samples.size(), -99.f);
+  REQUIRE(controller.copy_sampled_controls(samples, some));
+  const auto all = controller.sampled_controls();
+  const std::size_t padded = static_cast<std::size_t>(mppi::padded_sample_count(o.num_samples));
+  REQUIRE(all.size() == static_cast<std::size_t>(o.horizon) * padded);
+  // iteration counter of the second step's (only) iteration: one per iteration since reset
+  const std::uint32_t iteration = 1;
+  for (std::size_t j = 0; j < samples.size(); ++j)
+    for (int t = 0; t < o.horizon; ++t) {
+      const float n = mppi::normal_at(mppi::NoiseKey{o.seed}, iteration, static_cast<std::uint32_t>(samples[j]),
+                                      static_cast<std::uint32_t>(t), 0);
+      const float expected = std::clamp(nominal[t] + o.noise_std[0] * n, o.control_min[0], o.control_max[0]);
+      REQUIRE(some[t * samples.size() + j] == Approx(expected).margin(1e-6));
+      REQUIRE(all[t * padded + static_cast<std::size_t>(samples[j])] == some[t * samples.size() + j]);
+    }
+  // out of range, or too little room: refused
+  std::vector<int> bad = {333};
+  CHECK_FALSE(controller.copy_sampled_controls(bad, some));
+  bad = {-1};
+  CHECK_FALSE(controller.copy_sampled_controls(bad, some));
+  CHECK_FALSE(controller.copy_sampled_controls(samples, std::span<float>(some).first(5)));
 }
