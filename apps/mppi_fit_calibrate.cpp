@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "dynamics/autorally_nn.hpp"
+#include "dynamics/corrected_model.hpp"
+#include "dynamics/effects.hpp"
 #include "dynamics/model_registry.hpp"
 #include "dynamics/vehicle_params.hpp"
 #include "mppi/error.hpp"
@@ -32,7 +34,11 @@ const char* kCalibrateUsage = R"(usage: mppi-fit calibrate [options]
                        (default data/config/autorally_<model>_uncalibrated.yaml)
   --estimate A,B,...   parameters to fit (default: max_steer_rad, stall_torque_Nm,
                        no_load_speed_mps, brake_torque_ratio, rolling_resistance,
-                       aero_drag_kgpm, tyre.B, tyre.C, tyre.D, tyre.E, tyre.Sv)
+                       aero_drag_kgpm, tyre.B, tyre.C, tyre.D, tyre.E, tyre.Sv); also
+                       rear_tyre_B_scale, rear_tyre_C_scale, rear_tyre_D_scale (per-axle
+                       tyres) and the single-track's actuator terms steer_lag_s,
+                       throttle_lag_s, steer_cubic, steer_offset (then calibrated.yaml is a
+                       corrected-model file: mppi-sim --plant corrected --plant-params)
   --train-s S          training command sequence length                     (100)
   --heldout-s S        held-out command sequence length                     (100)
   --seed N             training seed; the held-out sequence uses N + 1000   (1)
@@ -197,9 +203,30 @@ int mppi_fit_calibrate(int argc, char** argv) {
     write_recording(train, out_dir + "/train.csv");
     write_recording(held, out_dir + "/heldout.csv");
     {
+      // Fitted actuator terms (steer_lag_s, ...) are effects of the corrected model: then the
+      // file is a corrected-model file (the plant as nominal_params, the actuators as effects)
+      // that mppi-sim loads with --plant corrected --plant-params FILE.
+      // Only actuator effects: aero_drag_kgpm is also the plant's own key (and an extra-force effect).
+      CorrectedModelFile corrected;
+      bool actuators = false;
+      for (std::size_t i = 0; i < fit.names.size(); ++i)
+        for (const EffectSpec& e : effect_table())
+          for (const EffectParamSpec& q : e.params)
+            if (e.hook == EffectHook::kActuator && fit.names[i] == q.name) {
+              corrected.effects.*(q.member) = fit.values[i];
+              actuators = true;
+            }
       std::ofstream y(out_dir + "/calibrated.yaml");
-      y << "# " << model << " parameters calibrated by mppi-fit calibrate to " << net_path << "\n";
-      y << spec.to_yaml(fit.values);
+      const std::string comment = model + " parameters calibrated by mppi-fit calibrate to " + net_path;
+      if (actuators && model == models::SingleTrackModel::kName) {
+        corrected.nominal = single_track_params_from_yaml(spec.to_yaml(fit.values), out_dir + "/calibrated.yaml");
+        for (const EffectSpec& e : effect_table())
+          for (const EffectParamSpec& q : e.params)
+            if (corrected.effects.*(q.member) != EffectParams{}.*(q.member)) corrected.selected.push_back(e.id);
+        y << corrected_model_to_yaml(corrected, comment);
+      } else {
+        y << "# " << comment << "\n" << spec.to_yaml(fit.values);
+      }
     }
     std::string summary;
     char line[256];

@@ -52,7 +52,7 @@ struct FourWheelCoeffs {
   T load_per_fx[4], load_per_fy[4];     // a_i, b_i [N/N]
   T max_steer, stall_torque, brake_ratio, inv_no_load_speed, rolling_force, inv_rolling_speed, drag;
   T slip_floor, inv_slip_blend;
-  PacejkaCoeffs<T> tyre;
+  PacejkaCoeffs<T> tyre, rear_tyre;  // front, rear axle
 
   // Geometry, tyres, drivetrain and static loads from the single-track parameters and tracks;
   // the load-transfer rows a_i = -+h_long / (2 L), b_i = -+roll_k / w_k (roll_k: N/N per axle).
@@ -89,6 +89,7 @@ struct FourWheelCoeffs {
     k.slip_floor = t(p.slip_speed_floor_mps);
     k.inv_slip_blend = t(1 / p.slip_blend);
     k.tyre = PacejkaCoeffs<T>::from(p.tyre);
+    k.rear_tyre = PacejkaCoeffs<T>::from(p.rear_tyre());
     return k;
   }
 };
@@ -125,7 +126,7 @@ template <class T>
     e->wheel_vx_mps[i] = cvx * c + cvy * s;
     e->wheel_vy_mps[i] = -cvx * s + cvy * c;
     e->tyre[i] = tyre_friction(e->wheel_vx_mps[i], e->wheel_vy_mps[i], omega[i] * k.radius,
-                               k.slip_floor, k.inv_slip_blend, k.tyre);
+                               k.slip_floor, k.inv_slip_blend, i < 2 ? k.tyre : k.rear_tyre);
     mbx[i] = e->tyre[i].mu_x * c - e->tyre[i].mu_y * s;
     mby[i] = e->tyre[i].mu_x * s + e->tyre[i].mu_y * c;
   }
@@ -316,6 +317,8 @@ class DoubleTrack {
     f.slip_floor = t(d.slip_floor);
     f.inv_slip_blend = t(d.inv_slip_blend);
     f.tyre = {t(d.tyre.B), t(d.tyre.C), t(d.tyre.D), t(d.tyre.E), t(d.tyre.Sh), t(d.tyre.Sv)};
+    f.rear_tyre = {t(d.rear_tyre.B), t(d.rear_tyre.C), t(d.rear_tyre.D), t(d.rear_tyre.E), t(d.rear_tyre.Sh),
+                   t(d.rear_tyre.Sv)};
     return f;
   }
 

@@ -10,7 +10,8 @@
 //   I_f domega_f = -fFx R,   I_r domega_r = T_rear - fRx R
 // T_rear = T_stall (max(u, 0) + k_brake min(u, 0) - omega_r R / v_no_load) (vehicle_params.hpp).
 // Tyre-frame velocities: front (Vx cos d + (Vy + r l_f) sin d, -Vx sin d + (Vy + r l_f) cos d),
-// rear (Vx, Vy - r l_r); friction from dynamics/pacejka.hpp; normal loads from Velenis'
+// rear (Vx, Vy - r l_r); friction from dynamics/pacejka.hpp (the rear tyre's B, C, D scaled by
+// rear_tyre_*_scale); normal loads from Velenis'
 // quasi-static pitch transfer
 //   f_Fz = m g (l_r - h mu_Rx) / (l_f + l_r + h (mu_Fx cos d - mu_Fy sin d - mu_Rx)),
 //   f_Rz = m g - f_Fz   (explicit: mu_k = f_k / f_z does not depend on f_z), clamped to [0, m g].
@@ -38,7 +39,8 @@ struct SingleTrackCoeffs {
   T weight;  // m g [N]
   T max_steer, stall_torque, brake_ratio, inv_no_load_speed, rolling_force, inv_rolling_speed, drag;
   T slip_floor, inv_slip_blend;
-  PacejkaCoeffs<T> tyre;
+  PacejkaCoeffs<T> tyre;       // front axle
+  PacejkaCoeffs<T> rear_tyre;  // rear axle (SingleTrackParams::rear_tyre())
 
   static SingleTrackCoeffs from(const SingleTrackParams& p) noexcept {
     auto t = [](double v) { return static_cast<T>(v); };
@@ -48,7 +50,8 @@ struct SingleTrackCoeffs {
             t(p.mass_kg * p.gravity_mps2), t(p.max_steer_rad), t(p.stall_torque_Nm), t(p.brake_torque_ratio),
             t(1 / p.no_load_speed_mps), t(p.rolling_resistance * p.mass_kg * p.gravity_mps2),
             t(1 / p.rolling_resistance_speed_mps), t(p.aero_drag_kgpm), t(p.slip_speed_floor_mps),
-            t(1 / p.slip_blend), PacejkaCoeffs<T>::from(p.tyre)};
+            t(1 / p.slip_blend), PacejkaCoeffs<T>::from(p.tyre),
+            PacejkaCoeffs<T>::from(p.rear_tyre())};
   }
 };
 
@@ -84,7 +87,7 @@ inline void single_track_terms(const SingleTrackCoeffs<T>& k, T vx, T vy, T r, T
   e->front = tyre_friction(e->front_vx_mps, e->front_vy_mps, omega_f * k.radius, k.slip_floor,
                            k.inv_slip_blend, k.tyre);
   e->rear = tyre_friction(e->rear_vx_mps, e->rear_vy_mps, omega_r * k.radius, k.slip_floor,
-                          k.inv_slip_blend, k.tyre);
+                          k.inv_slip_blend, k.rear_tyre);
   const T den = k.lf + k.lr + k.h * (e->front.mu_x * cd - e->front.mu_y * sd - e->rear.mu_x);
   // den > 0 is guaranteed by SingleTrackParams::is_valid; the floor only keeps NaN out.
   const T fz_front = k.weight * (k.lr - k.h * e->rear.mu_x) / std::max(den, T(1e-3));

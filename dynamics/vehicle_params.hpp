@@ -50,8 +50,21 @@ struct SingleTrackParams {
   // at 1 m/s. The 500 Hz plant would be fine with 1 m/s.
   double slip_speed_floor_mps = 3.0;      // v_floor [m/s] in max(|omega R|, v_floor)
   double slip_blend = 0.1;                // eps [-]: force x tanh(s / eps) -> 0 at zero slip
+  // Per-axle tyres: the rear tyre is `tyre` with B, C, D scaled by these (E, Sh, Sv shared);
+  // 1 = the same tyre on both axles (the paper identifies one tyre for the whole car).
+  double rear_tyre_B_scale = 1.0;         // rear stiffness factor / front [-]
+  double rear_tyre_C_scale = 1.0;         // rear shape factor / front [-]
+  double rear_tyre_D_scale = 1.0;         // rear peak factor / front [-]
 
   double wheelbase_m() const { return cg_to_front_axle_m + cg_to_rear_axle_m; }
+  // The rear axle's tyre: `tyre` with the rear scales applied.
+  PacejkaParams rear_tyre() const {
+    PacejkaParams t = tyre;
+    t.B *= rear_tyre_B_scale;
+    t.C *= rear_tyre_C_scale;
+    t.D *= rear_tyre_D_scale;
+    return t;
+  }
   bool is_valid(std::string* why) const;
 };
 
@@ -199,6 +212,9 @@ inline std::vector<ParamField> param_table(SingleTrackParams& p, bool with_aero_
       param("aero_drag_kgpm", &p.aero_drag_kgpm, "N s^2/m^2", non_negative(), "drag c_d (force c_d vx |vx|)"),
       param("slip_speed_floor_mps", &p.slip_speed_floor_mps, "m/s", positive(), "slip denominator floor v_floor"),
       param("slip_blend", &p.slip_blend, "-", positive(), "slip blend eps: force x tanh(s / eps)"),
+      param("rear_tyre_B_scale", &p.rear_tyre_B_scale, "-", positive(), "rear tyre stiffness factor B / front B"),
+      param("rear_tyre_C_scale", &p.rear_tyre_C_scale, "-", positive(), "rear tyre shape factor C / front C"),
+      param("rear_tyre_D_scale", &p.rear_tyre_D_scale, "-", positive(), "rear tyre peak factor D / front D"),
   };
   if (!with_aero_drag) f.erase(f.begin() + 15);  // aero_drag_kgpm
   for (const ParamField& t : param_table(p.tyre)) f.push_back(t);
@@ -257,11 +273,14 @@ inline bool SingleTrackParams::is_valid(std::string* why) const {
   fields.resize(fields.size() - 6);  // the tyre: checked whole by PacejkaParams::is_valid
   if (const std::string e = first_range_error(fields); !e.empty()) return fail(e);
   if (!tyre.is_valid(why)) return false;
+  if (std::string rear_why; !rear_tyre().is_valid(&rear_why))
+    return fail("rear tyre (tyre scaled by rear_tyre_*_scale): " + rear_why);
   // The load-transfer denominator l_f + l_r + h (mu_Fx cos d - mu_Fy sin d - mu_Rx) stays
   // positive for any slips when h * 2 * max|mu| < wheelbase.
-  const double mu_bound = std::abs(tyre.D) + std::abs(tyre.Sv);
+  const double mu_bound = std::abs(tyre.D) * std::max(1.0, rear_tyre_D_scale) + std::abs(tyre.Sv);
   if (!(2 * cg_height_m * mu_bound < wheelbase_m()))
-    return fail("cg_height_m too large for the wheelbase and tyre grip (need 2 h (|D|+|Sv|) < l_f + l_r)");
+    return fail("cg_height_m too large for the wheelbase and tyre grip (need 2 h (|D| max(1, rear_tyre_D_scale) + "
+                "|Sv|) < l_f + l_r)");
   return true;
 }
 

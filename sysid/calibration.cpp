@@ -59,6 +59,7 @@ void residuals(const VehicleModelSpec& spec, const std::vector<double>& values, 
   std::size_t k = 0;
   for (std::size_t s : p.starts) {
     spec.init_state(rec, s, x.data());
+    if (spec.prime) spec.prime(values, rec, s, x.data());
     bool diverged = false;
     for (int lead = 1; lead <= p.steps; ++lead) {
       const std::size_t i = s + static_cast<std::size_t>(lead);
@@ -198,6 +199,16 @@ CalibrationResult calibrate(const VehicleModelSpec& spec, const sim::Recording& 
       lo[i] = 0.05, hi[i] = 1.99;
     } else if (n == "tyre.E") {
       lo[i] = -10, hi[i] = 0.99;
+    } else if (n == "rear_tyre_C_scale") {  // keeps the rear C inside (0, 2) for front C up to 1.2
+      lo[i] = 0.3, hi[i] = 1.6;
+    } else if (n == "rear_tyre_B_scale" || n == "rear_tyre_D_scale") {
+      lo[i] = 0.3, hi[i] = 3.0;
+    } else if (n == "steer_lag_s" || n == "throttle_lag_s") {
+      lo[i] = 0, hi[i] = 0.5;
+    } else if (n == "steer_cubic") {
+      lo[i] = -0.9, hi[i] = 1.9;
+    } else if (n == "steer_offset") {
+      lo[i] = -0.3, hi[i] = 0.3;
     } else {
       lo[i] = -std::numeric_limits<double>::infinity(), hi[i] = std::numeric_limits<double>::infinity();
     }
@@ -215,6 +226,11 @@ CalibrationResult calibrate(const VehicleModelSpec& spec, const sim::Recording& 
   auto project = [&](Eigen::VectorXd& z) {
     for (std::size_t i = 0; i < np; ++i) z[static_cast<Eigen::Index>(i)] = std::clamp(z[static_cast<Eigen::Index>(i)], lo[i], hi[i]);
   };
+  // A lag of 0 has no derivative (a forward step of 1e-4 s is far below the 2-ms substep): start
+  // lags that would begin at 0 at 0.05 s.
+  for (std::size_t i = 0; i < np; ++i)
+    if ((spec.estimated[i] == "steer_lag_s" || spec.estimated[i] == "throttle_lag_s") && initial[i] == 0)
+      initial[i] = 0.05;
   Eigen::VectorXd z(static_cast<Eigen::Index>(np));
   for (std::size_t i = 0; i < np; ++i) {
     if (spec.log_scale[i] && !(initial[i] > 0)) throw Error("calibrate: " + spec.estimated[i] + " must start > 0");

@@ -51,7 +51,10 @@ struct CalibrationOptions {
   int max_iterations = 40;
   double relative_tolerance = 1e-5;  // stop when the cost falls less than this (relative)
   // Box, per parameter: positive (log-scale) ones within [nominal / range, nominal x range];
-  // tyre.C in [0.05, 1.99], tyre.E in [-10, 0.99], other linear ones unbounded.
+  // tyre.C in [0.05, 1.99], tyre.E in [-10, 0.99], rear_tyre_C_scale in [0.3, 1.6],
+  // rear_tyre_B_scale and rear_tyre_D_scale in [0.3, 3], steer_lag_s and throttle_lag_s in
+  // [0, 0.5] s, steer_cubic in [-0.9, 1.9], steer_offset in [-0.3, 0.3]; other linear ones
+  // unbounded.
   double log_range = 20.0;
   std::vector<std::pair<double, double>> bounds;  // overrides (physical units), one per parameter
 
@@ -68,7 +71,8 @@ struct CalibrationResult {
 };
 
 // Fits spec's estimated parameters, starting from `initial` (default: spec.nominal), to
-// minimise the mean squared normalised prediction residual on `rec` with `scales`.
+// minimise the mean squared normalised prediction residual on `rec` with `scales`. A lag
+// (steer_lag_s, throttle_lag_s) that would start at 0, where it has no derivative, starts at 0.05 s.
 CalibrationResult calibrate(const VehicleModelSpec& spec, const sim::Recording& rec,
                             const std::vector<double>& scales, const CalibrationOptions& options = {},
                             std::vector<double> initial = {});

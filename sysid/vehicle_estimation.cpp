@@ -37,7 +37,10 @@ double* single_track_field(SingleTrackParams& p, const std::string& n) {
       {"rolling_resistance", &SingleTrackParams::rolling_resistance},
       {"aero_drag_kgpm", &SingleTrackParams::aero_drag_kgpm},
       {"slip_speed_floor_mps", &SingleTrackParams::slip_speed_floor_mps},
-      {"slip_blend", &SingleTrackParams::slip_blend}};
+      {"slip_blend", &SingleTrackParams::slip_blend},
+      {"rear_tyre_B_scale", &SingleTrackParams::rear_tyre_B_scale},
+      {"rear_tyre_C_scale", &SingleTrackParams::rear_tyre_C_scale},
+      {"rear_tyre_D_scale", &SingleTrackParams::rear_tyre_D_scale}};
   static const std::map<std::string, double PacejkaParams::*> t = {
       {"tyre.B", &PacejkaParams::B}, {"tyre.C", &PacejkaParams::C}, {"tyre.D", &PacejkaParams::D},
       {"tyre.E", &PacejkaParams::E}, {"tyre.Sh", &PacejkaParams::Sh}, {"tyre.Sv", &PacejkaParams::Sv}};
@@ -71,7 +74,50 @@ double* double_track_field(DoubleTrackParams& p, const std::string& n) {
   return single_track_field(p.base, n);
 }
 
-bool is_linear_param(const std::string& n) { return n == "tyre.E" || n == "tyre.Sh" || n == "tyre.Sv"; }
+// The single-track's actuators as the calibration models them (the steering servo and the drive's
+// response; the same terms as the effects steer_lag, throttle_lag, steer_cubic and steer_offset of
+// WithEffects, dynamics/effects.hpp): first-order lags of the commands, then the steering map
+// s -> s + k s^3 + offset.
+struct Actuators {
+  double steer_lag_s = 0;     // [s] first-order time constant of the steering servo
+  double throttle_lag_s = 0;  // [s] first-order time constant of the drive
+  double steer_cubic = 0;     // [-] k in s -> s + k s^3
+  double steer_offset = 0;    // [-] added to the applied steer
+};
+struct SingleTrackWithActuators {
+  SingleTrackParams car;
+  Actuators act;
+};
+constexpr double kActuatorPrime_s = 1.0;  // command history run through the lags before a start
+
+double* actuator_field(Actuators& a, const std::string& n) {
+  if (n == "steer_lag_s") return &a.steer_lag_s;
+  if (n == "throttle_lag_s") return &a.throttle_lag_s;
+  if (n == "steer_cubic") return &a.steer_cubic;
+  if (n == "steer_offset") return &a.steer_offset;
+  return nullptr;
+}
+bool is_actuator_param(const std::string& n) {
+  Actuators a;
+  return actuator_field(a, n) != nullptr;
+}
+double* single_track_or_actuator_field(SingleTrackWithActuators& p, const std::string& n) {
+  if (double* f = actuator_field(p.act, n)) return f;
+  return single_track_field(p.car, n);
+}
+
+// Advances the two lag states y (steer, throttle) over h with commands u held: y += (1 - e^(-h/tau)) (u - y).
+void advance_actuators(const Actuators& a, const double* u, double h, double* y) {
+  const double as = a.steer_lag_s > 0 ? 1 - std::exp(-h / a.steer_lag_s) : 1.0;
+  const double at = a.throttle_lag_s > 0 ? 1 - std::exp(-h / a.throttle_lag_s) : 1.0;
+  y[0] += as * (u[0] - y[0]);
+  y[1] += at * (u[1] - y[1]);
+}
+double applied_steer(const Actuators& a, double s) { return s + a.steer_cubic * s * s * s + a.steer_offset; }
+
+bool is_linear_param(const std::string& n) {
+  return n == "tyre.E" || n == "tyre.Sh" || n == "tyre.Sv" || is_actuator_param(n);
+}
 
 std::string join(const std::vector<std::string>& v) {
   std::string s;
@@ -114,12 +160,15 @@ std::vector<std::string> single_track_param_names() {
   return {"mass_kg", "yaw_inertia_kgm2", "cg_to_front_axle_m", "cg_to_rear_axle_m", "cg_height_m",
           "wheel_radius_m", "front_wheel_inertia_kgm2", "rear_wheel_inertia_kgm2", "max_steer_rad",
           "stall_torque_Nm", "no_load_speed_mps", "brake_torque_ratio", "rolling_resistance", "aero_drag_kgpm",
-          "tyre.B", "tyre.C", "tyre.D", "tyre.E", "tyre.Sh", "tyre.Sv", "slip_speed_floor_mps", "slip_blend"};
+          "tyre.B", "tyre.C", "tyre.D", "tyre.E", "tyre.Sh", "tyre.Sv", "slip_speed_floor_mps", "slip_blend",
+          "rear_tyre_B_scale", "rear_tyre_C_scale", "rear_tyre_D_scale", "steer_lag_s", "throttle_lag_s",
+          "steer_cubic", "steer_offset"};
 }
 
 std::vector<std::string> full_vehicle_param_names() {
   auto v = single_track_param_names();
   v.erase(std::find(v.begin(), v.end(), "aero_drag_kgpm"));
+  v.erase(std::remove_if(v.begin(), v.end(), is_actuator_param), v.end());  // single-track only
   for (const char* n : {"front_track_m", "rear_track_m", "front_spring_Npm", "rear_spring_Npm",
                         "front_damper_Nspm", "rear_damper_Nspm", "sprung_cg_height_m",
                         "roll_centre_height_m", "roll_inertia_kgm2", "pitch_inertia_kgm2", "drag_coefficient"})
@@ -137,20 +186,35 @@ VehicleModelSpec single_track_spec(const SingleTrackParams& base, const std::vec
   s.state_names = {"x", "y", "yaw", "vx", "vy", "yaw_rate", "roll", "omega_front", "omega_rear"};
   s.measurable = {{"x", 0}, {"y", 1}, {"yaw", 2}, {"vx", 3}, {"vy", 4}, {"yaw_rate", 5},
                   {"omega_front", 7}, {"omega_rear", 8}};
-  prepare(s, base, estimated, single_track_param_names(), single_track_field);
+  const SingleTrackWithActuators base_all{base, {}};
+  prepare(s, base_all, estimated, single_track_param_names(), single_track_or_actuator_field);
+  const bool actuators = std::any_of(s.estimated.begin(), s.estimated.end(),
+                                     [](const std::string& n) { return is_actuator_param(n); });
+  if (actuators) {  // the steer and throttle actuator outputs become states
+    s.nx = SingleTrack::kNx + 2;
+    s.state_names.push_back("steer_applied");
+    s.state_names.push_back("throttle_applied");
+  }
   const double wheelbase = base.wheelbase_m();
   const std::vector<std::string> names = s.estimated;
-  auto with = [base, names, keep_wheelbase, wheelbase](const std::vector<double>& v) {
-    SingleTrackParams p = base;
-    for (std::size_t i = 0; i < names.size(); ++i) *single_track_field(p, names[i]) = v[i];
-    if (keep_wheelbase) p.cg_to_rear_axle_m = std::max(1e-3, wheelbase - p.cg_to_front_axle_m);
+  auto with = [base_all, names, keep_wheelbase, wheelbase](const std::vector<double>& v) {
+    SingleTrackWithActuators p = base_all;
+    for (std::size_t i = 0; i < names.size(); ++i) *single_track_or_actuator_field(p, names[i]) = v[i];
+    if (keep_wheelbase) p.car.cg_to_rear_axle_m = std::max(1e-3, wheelbase - p.car.cg_to_front_axle_m);
     return p;
   };
-  s.step = [with](const std::vector<double>& v, double* x, const double* u, double dt) {
-    const SingleTrackCoeffs<double> k = SingleTrackCoeffs<double>::from(with(v));
+  s.step = [with, actuators](const std::vector<double>& v, double* x, const double* u, double dt) {
+    const SingleTrackWithActuators p = with(v);
+    const SingleTrackCoeffs<double> k = SingleTrackCoeffs<double>::from(p.car);
     substep(dt, 0.002, [&](double h) {
+      double steer = u[0], throttle = u[1];
+      if (actuators) {
+        advance_actuators(p.act, u, h, x + SingleTrack::kNx);
+        steer = applied_steer(p.act, x[SingleTrack::kNx]);
+        throttle = x[SingleTrack::kNx + 1];
+      }
       SingleTrackTerms<double> e;
-      single_track_terms(k, x[3], x[4], x[5], x[7], x[8], u[0], u[1], &e);
+      single_track_terms(k, x[3], x[4], x[5], x[7], x[8], steer, throttle, &e);
       const double sy = std::sin(x[2]), cy = std::cos(x[2]);
       x[0] += (cy * x[3] - sy * x[4]) * h;
       x[1] += (sy * x[3] + cy * x[4]) * h;
@@ -163,21 +227,43 @@ VehicleModelSpec single_track_spec(const SingleTrackParams& base, const std::vec
     });
   };
   const double radius = base.wheel_radius_m;
-  s.init_state = [radius](const sim::Recording& rec, std::size_t row, double* x) {
+  s.init_state = [radius, actuators](const sim::Recording& rec, std::size_t row, double* x) {
     const char* cols[6] = {"x", "y", "yaw", "vx", "vy", "yaw_rate"};
     for (int i = 0; i < 6; ++i) x[i] = value_or(rec, cols[i], row, 0.0);
     x[6] = 0;
     const double w = value_or(rec, "wheel_speed", row, x[3]) / radius;
     x[7] = value_or(rec, "omega_front", row, w);
     x[8] = value_or(rec, "omega_rear", row, w);
+    if (actuators) {  // steady at the last command until prime() runs the history through them
+      x[SingleTrack::kNx] = row > 0 ? rec.column("steer")[row - 1] : 0.0;
+      x[SingleTrack::kNx + 1] = row > 0 ? rec.column("throttle")[row - 1] : 0.0;
+    }
   };
-  s.to_yaml = [with](const std::vector<double>& v) { return to_yaml(with(v)); };
+  if (actuators)
+    s.prime = [with](const std::vector<double>& v, const sim::Recording& rec, std::size_t row, double* x) {
+      const SingleTrackWithActuators p = with(v);
+      const auto& t = rec.column("t");
+      const auto& steer = rec.column("steer");
+      const auto& throttle = rec.column("throttle");
+      std::size_t first = row;
+      while (first > 0 && t[row] - t[first - 1] <= kActuatorPrime_s) --first;
+      if (first == row) return;
+      x[SingleTrack::kNx] = steer[first];
+      x[SingleTrack::kNx + 1] = throttle[first];
+      for (std::size_t i = first; i < row; ++i) {
+        const double u[2] = {steer[i], throttle[i]};
+        advance_actuators(p.act, u, t[i + 1] - t[i], x + SingleTrack::kNx);
+      }
+    };
+  s.to_yaml = [with](const std::vector<double>& v) { return to_yaml(with(v).car); };
   s.process_std_per_sqrt_s = {0.01, 0.01, 0.005, 0.2, 0.2, 0.2, 1e-6, 5.0, 5.0};
+  if (actuators) s.process_std_per_sqrt_s.insert(s.process_std_per_sqrt_s.end(), {0.01, 0.01});
   return s;
 }
 
 std::vector<std::string> double_track_param_names() {
   auto v = single_track_param_names();
+  v.erase(std::remove_if(v.begin(), v.end(), is_actuator_param), v.end());  // single-track only
   for (const char* n : {"front_track_m", "rear_track_m", "front_roll_share"}) v.push_back(n);
   return v;
 }
@@ -464,9 +550,11 @@ ValidationResult validate_parameters(const VehicleModelSpec& spec, const std::ve
   auto run = [&](bool open_loop, std::vector<double>& sq, std::vector<int>& cnt) {
     double chunk_start = t[begin];
     spec.init_state(rec, begin, x.data());
+    if (spec.prime) spec.prime(values, rec, begin, x.data());
     for (std::size_t i = begin; i < end; ++i) {
       if (!open_loop && t[i] - chunk_start >= horizon_s - 1e-9) {
         spec.init_state(rec, i, x.data());
+        if (spec.prime) spec.prime(values, rec, i, x.data());
         chunk_start = t[i];
       }
       for (int c = 0; c < nc; ++c) {

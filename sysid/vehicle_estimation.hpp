@@ -29,6 +29,10 @@ struct VehicleModelSpec {
   std::function<void(const std::vector<double>& values, double* x, const double* u, double dt)> step;
   // A full state from a recording row (unmeasured states from the measured ones).
   std::function<void(const sim::Recording& rec, std::size_t row, double* x)> init_state;
+  // Optional, after init_state: states that depend on the parameters and the command history
+  // before `row` (the single-track's actuator lags, run over the preceding commands).
+  std::function<void(const std::vector<double>& values, const sim::Recording& rec, std::size_t row, double* x)>
+      prime;
   // The base parameters with `values` set, as a YAML file the simulator/controller loads.
   std::function<std::string(const std::vector<double>& values)> to_yaml;
   // Per-state process-noise standard deviation per second (scaled by sqrt(dt)).

@@ -66,7 +66,10 @@ struct SingleTrackModel {
             MPPI_COEFF("K_D", tyre.D),
             MPPI_COEFF("K_E", tyre.E),
             MPPI_COEFF("K_SH", tyre.Sh),
-            MPPI_COEFF("K_SV", tyre.Sv)};
+            MPPI_COEFF("K_SV", tyre.Sv),
+            MPPI_COEFF("K_RB", rear_tyre.B),
+            MPPI_COEFF("K_RC", rear_tyre.C),
+            MPPI_COEFF("K_RD", rear_tyre.D)};
 #undef MPPI_COEFF
   }
 };

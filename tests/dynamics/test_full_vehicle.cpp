@@ -361,7 +361,8 @@ TEST_CASE("Full-vehicle parameters: YAML file, round trip, errors", "[physics][f
   CHECK(found == 2);
   CHECK(named.front_spring_Npm == 1234.0);
   CHECK(named.base.tyre.Sv == 0.2);
-  CHECK(mppi::named_parameters(named).size() == 17 + 15 + 6);  // single-track core (with brake_torque_ratio), chassis, corners
+  // single-track core (with brake_torque_ratio and the three rear-tyre scales), chassis, corners
+  CHECK(mppi::named_parameters(named).size() == 20 + 15 + 6);
 
   using mppi::test::error_of;
   CHECK_THAT(error_of([] { mppi::full_vehicle_params_from_yaml("aero_drag_kgpm: 0.05\n", "fv.yaml"); }),

@@ -29,20 +29,23 @@ using State = std::array<double, 9>;
 // ---- Independent reference, from the paper (Velenis 2010 equations, Magic Formula) --------
 // Written without the model's helpers: complex numbers for the frame rotations, the normal
 // load solved from the pitch moment balance about the rear contact point.
-double ref_mu(const SingleTrackParams& p, double s) {
+// The rear tyre has B, C, D multiplied by rear_tyre_{B,C,D}_scale (E, Sh, Sv shared).
+double ref_mu(const SingleTrackParams& p, double s, bool rear) {
   const auto& t = p.tyre;
+  const double B = rear ? t.B * p.rear_tyre_B_scale : t.B, C = rear ? t.C * p.rear_tyre_C_scale : t.C,
+               D = rear ? t.D * p.rear_tyre_D_scale : t.D;
   const double x = s - t.Sh;
-  return t.D * std::sin(t.C * std::atan(t.B * x - t.E * (t.B * x - std::atan(x)))) + t.Sv;
+  return D * std::sin(C * std::atan(B * x - t.E * (B * x - std::atan(x)))) + t.Sv;
 }
 
 // Friction coefficient vector (tyre frame) of a tyre moving at `v` with rim speed `rim`:
 // -(s/|s|) mu(|s|) tanh(|s|/eps) with s = (v - rim, v_y) / max(|rim|, v_floor).
-std::complex<double> ref_friction(const SingleTrackParams& p, std::complex<double> v, double rim) {
+std::complex<double> ref_friction(const SingleTrackParams& p, std::complex<double> v, double rim, bool rear) {
   const double den = std::max(std::abs(rim), p.slip_speed_floor_mps);
   const std::complex<double> slip((v.real() - rim) / den, v.imag() / den);
   const double s = std::abs(slip);
   if (s == 0) return 0.0;
-  return -slip / s * ref_mu(p, s) * std::tanh(s / p.slip_blend);
+  return -slip / s * ref_mu(p, s, rear) * std::tanh(s / p.slip_blend);
 }
 
 State ref_rhs(const SingleTrackParams& p, const State& x, double steer, double throttle) {
@@ -53,8 +56,8 @@ State ref_rhs(const SingleTrackParams& p, const State& x, double steer, double t
   const std::complex<double> to_wheel = std::polar(1.0, -delta), to_body = std::polar(1.0, delta);
   const std::complex<double> v_front = std::complex<double>(vx, vy + r * lf) * to_wheel;
   const std::complex<double> v_rear(vx, vy - r * lr);
-  const std::complex<double> mu_front = ref_friction(p, v_front, wf * R);
-  const std::complex<double> mu_rear = ref_friction(p, v_rear, wr * R);
+  const std::complex<double> mu_front = ref_friction(p, v_front, wf * R, false);
+  const std::complex<double> mu_rear = ref_friction(p, v_rear, wr * R, true);
   // Pitch moment about the rear contact: Ffz (lf + lr) - m g lr + h Fx_total = 0 with
   // Fx_total = Re(mu_front e^{i delta}) Ffz + Re(mu_rear) (m g - Ffz).
   const double front_x_per_load = (mu_front * to_body).real();
@@ -151,7 +154,13 @@ TEST_CASE("Single-track derivatives at nontrivial states: numpy and independent 
 }
 
 TEST_CASE("Single-track derivatives match the reference at random states", "[physics][single_track]") {
-  const SingleTrackParams p;
+  SingleTrackParams p;
+  SECTION("one tyre on both axles") {}
+  SECTION("per-axle tyres: the rear's B, C, D scaled") {
+    p.rear_tyre_B_scale = 1.7;
+    p.rear_tyre_C_scale = 0.8;
+    p.rear_tyre_D_scale = 1.2;
+  }
   const SingleTrack model(p);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> U(-1, 1);
@@ -394,6 +403,15 @@ TEST_CASE("SingleTrack rejects invalid parameters and initialises rolling wheels
   CHECK_THROWS_WITH(SingleTrack(p), Catch::Contains("mass_kg"));
   p = {};
   p.cg_height_m = 0.3;  // 2 h (D + Sv) = 0.68 > wheelbase: the load formula could divide by 0
+  CHECK_THROWS_WITH(SingleTrack(p), Catch::Contains("cg_height_m"));
+  p = {};
+  p.rear_tyre_D_scale = 0;
+  CHECK_THROWS_WITH(SingleTrack(p), Catch::Contains("rear_tyre_D_scale"));
+  p = {};
+  p.rear_tyre_C_scale = 1.8;  // rear C = 1.19 x 1.8 = 2.15: outside the Magic Formula's (0, 2)
+  CHECK_THROWS_WITH(SingleTrack(p), Catch::Contains("rear tyre") && Catch::Contains("C"));
+  p = {};
+  p.rear_tyre_D_scale = 2.5;  // 2 h (2.5 D + Sv) = 0.63 > wheelbase: checked with the rear's peak
   CHECK_THROWS_WITH(SingleTrack(p), Catch::Contains("cg_height_m"));
   const SingleTrack model;
   float x[9];

@@ -148,6 +148,14 @@ TEST_CASE("Vulkan parity: single-track Pacejka model, AutoRally cost", "[vulkan]
   check_parity(mppi::SingleTrack{}, "single-track");
 }
 
+TEST_CASE("Vulkan parity: single-track with per-axle tyres, AutoRally cost", "[vulkan][parity]") {
+  mppi::SingleTrackParams p;  // the rear tyre differs in all three of B, C, D
+  p.rear_tyre_B_scale = 1.3;
+  p.rear_tyre_C_scale = 0.8;
+  p.rear_tyre_D_scale = 0.9;
+  check_parity(mppi::SingleTrack{p}, "single-track, per-axle tyres");
+}
+
 TEST_CASE("Vulkan rollout() of given controls equals the CPU backend's", "[vulkan][parity]") {
   const int device = mppi::test::vulkan_test_device();
   if (device < 0) return;

@@ -5,21 +5,22 @@
 float maxf(float a, float b) { return (a < b) ? b : a; }  // std::max
 float minf(float a, float b) { return (b < a) ? b : a; }  // std::min
 
-float magic_formula_mu(float total_slip) {
+// b, c, d: the axle's B, C, D (front K_B, K_C, K_D; rear K_RB, K_RC, K_RD); E, Sh, Sv shared.
+float magic_formula_mu(float total_slip, float b, float c_shape, float d) {
   precise float se = total_slip - K_SH;
-  precise float bse = K_B * se;
+  precise float bse = b * se;
   precise float s, c;
-  fast_sincos(K_C * fast_atan(bse - K_E * (bse - fast_atan(se))), s, c);
-  return K_D * s + K_SV;
+  fast_sincos(c_shape * fast_atan(bse - K_E * (bse - fast_atan(se))), s, c);
+  return d * s + K_SV;
 }
 
 // (mu_x, mu_y) of one tyre from its tyre-frame velocity and rim speed (tyre_friction()).
-vec2 tyre_mu(float v_x, float v_y, float rim_speed) {
+vec2 tyre_mu(float v_x, float v_y, float rim_speed, float b, float c_shape, float d) {
   precise float inv_den = 1.0 / maxf(abs(rim_speed), K_SLIP_FLOOR);
   precise float slip_x = (v_x - rim_speed) * inv_den;
   precise float slip_y = v_y * inv_den;
   precise float slip = fast_sqrt(slip_x * slip_x + slip_y * slip_y);
-  precise float mu = magic_formula_mu(slip);
+  precise float mu = magic_formula_mu(slip, b, c_shape, d);
   precise float scale = -mu * fast_tanh(slip * K_INV_SLIP_BLEND) / maxf(slip, 1e-12);
   return vec2(slip_x * scale, slip_y * scale);
 }
@@ -32,8 +33,8 @@ void model_step(inout float x[NX], float steer, float throttle, float dt) {
   precise float vy_front = vy + r * K_LF;
   precise float front_vx = vx * cd + vy_front * sd;
   precise float front_vy = -vx * sd + vy_front * cd;
-  vec2 fmu = tyre_mu(front_vx, front_vy, omega_f * K_RADIUS);
-  vec2 rmu = tyre_mu(vx, vy - r * K_LR, omega_r * K_RADIUS);
+  vec2 fmu = tyre_mu(front_vx, front_vy, omega_f * K_RADIUS, K_B, K_C, K_D);
+  vec2 rmu = tyre_mu(vx, vy - r * K_LR, omega_r * K_RADIUS, K_RB, K_RC, K_RD);
   precise float den = K_LF + K_LR + K_H * (fmu.x * cd - fmu.y * sd - rmu.x);
   precise float fz_front = K_WEIGHT * (K_LR - K_H * rmu.x) / maxf(den, 1e-3);
   precise float front_fz = minf(maxf(fz_front, 0.0), K_WEIGHT);
