@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -178,7 +179,11 @@ struct VulkanBackend::Impl {
 
   // Host-visible, coherent memory (device-local as well where the device offers it: then the
   // GPU reads and writes it at full speed and the host maps it directly).
-  void create_buffer(Buffer& b, VkDeviceSize bytes, VkBufferUsageFlags usage) {
+  // host_reads: the host reads this buffer after every iteration (costs, weights, the plan): it
+  // goes to host-cached memory where the device has it. A host read of device-local memory
+  // through the PCIe BAR is uncached, one bus round trip per read: on an H200 reading the K
+  // costs and weights back that way took ~0.5 ms at K = 2048.
+  void create_buffer(Buffer& b, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_reads = false) {
     b.bytes = std::max<VkDeviceSize>(bytes, 16);
     VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
     info.size = b.bytes;
@@ -189,7 +194,9 @@ struct VulkanBackend::Impl {
     api.vkGetBufferMemoryRequirements(device, b.buffer, &req);
     const VkMemoryPropertyFlags need = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
     std::uint32_t type = memory_props.memoryTypeCount;
-    for (VkMemoryPropertyFlags want : {need | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, need}) {
+    const VkMemoryPropertyFlags first =
+        host_reads ? need | VK_MEMORY_PROPERTY_HOST_CACHED_BIT : need | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+    for (VkMemoryPropertyFlags want : {first, need | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, need}) {
       for (std::uint32_t i = 0; i < memory_props.memoryTypeCount && type == memory_props.memoryTypeCount; ++i)
         if ((req.memoryTypeBits & (1u << i)) &&
             (memory_props.memoryTypes[i].propertyFlags & want) == want)
@@ -237,7 +244,10 @@ struct VulkanBackend::Impl {
     return pipeline;
   }
 
-  void create_pipelines(const TwinModel& model) {
+  // weights_in_shared: the model reads its parameters from workgroup memory (a GPU's constant
+  // cache is too small for the network's ~6 KB: read from the uniform buffer, every multiply-add
+  // waited for its weight); a CPU driver reads the uniform buffer faster.
+  void create_pipelines(const TwinModel& model, bool weights_in_shared) {
     VkDescriptorSetLayoutBinding bindings[kBindings];
     for (int i = 0; i < kBindings; ++i) {
       bindings[i] = {};
@@ -264,13 +274,16 @@ struct VulkanBackend::Impl {
       std::uint32_t group;
       VkBool32 generate;
       std::int32_t constant_a, constant_b;
+      VkBool32 weights_in_shared;
     };
     const VkSpecializationMapEntry entries[] = {{0, offsetof(Spec, group), 4},
                                                 {1, offsetof(Spec, generate), 4},
                                                 {2, offsetof(Spec, constant_a), 4},
-                                                {3, offsetof(Spec, constant_b), 4}};
-    Spec values{kRolloutGroup, VK_TRUE, std::max(model.constant_a, 1), std::max(model.constant_b, 1)};
-    VkSpecializationInfo spec{4, entries, sizeof(Spec), &values};
+                                                {3, offsetof(Spec, constant_b), 4},
+                                                {4, offsetof(Spec, weights_in_shared), 4}};
+    Spec values{kRolloutGroup, VK_TRUE, std::max(model.constant_a, 1), std::max(model.constant_b, 1),
+                weights_in_shared ? VK_TRUE : VK_FALSE};
+    VkSpecializationInfo spec{5, entries, sizeof(Spec), &values};
     rollout_generate = make_pipeline(code, bytes, &spec);
     values.generate = VK_FALSE;
     rollout_given = make_pipeline(code, bytes, &spec);
@@ -385,13 +398,13 @@ VulkanBackend::VulkanBackend(const TwinModel& model, const AutoRallyCost& cost, 
   m.create_buffer(m.buffers[Impl::kStep], sizeof(StepUbo), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   m.create_buffer(m.buffers[Impl::kNominal], plan * f, storage);
   m.create_buffer(m.buffers[Impl::kControls], plan * padded * f, storage);
-  m.create_buffer(m.buffers[Impl::kCosts], padded * f, storage);
+  m.create_buffer(m.buffers[Impl::kCosts], padded * f, storage, /*host_reads=*/true);
   m.create_buffer(m.buffers[Impl::kMap], map.values().size() * f, storage);
   m.create_buffer(m.buffers[Impl::kParams], kParamFloats * f, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   m.create_buffer(m.buffers[Impl::kCrash], static_cast<std::size_t>(horizon) * f, storage);
-  m.create_buffer(m.buffers[Impl::kWeights], padded * f, storage);
-  m.create_buffer(m.buffers[Impl::kStats], 8 * f, storage);
-  m.create_buffer(m.buffers[Impl::kNext], plan * f, storage);
+  m.create_buffer(m.buffers[Impl::kWeights], padded * f, storage, /*host_reads=*/true);
+  m.create_buffer(m.buffers[Impl::kStats], 8 * f, storage, /*host_reads=*/true);
+  m.create_buffer(m.buffers[Impl::kNext], plan * f, storage, /*host_reads=*/true);
 
   // Constant data: cost + model parameters, the cost map, the crash cost per step (computed
   // here with the CPU's own std::pow so both sides use the same numbers).
@@ -405,7 +418,11 @@ VulkanBackend::VulkanBackend(const TwinModel& model, const AutoRallyCost& cost, 
   std::copy(map.values().begin(), map.values().end(), m.buffers[Impl::kMap].f());
   for (int t = 0; t < horizon; ++t) m.buffers[Impl::kCrash].f()[t] = cost.crash_cost_at(t);
 
-  m.create_pipelines(model);
+  // MPPI_VULKAN_WEIGHTS_IN_SHARED=0/1 overrides the choice by device type (tests run the GPU's
+  // path on lavapipe with it).
+  const char* shared_env = std::getenv("MPPI_VULKAN_WEIGHTS_IN_SHARED");
+  const bool weights_in_shared = shared_env && *shared_env ? std::string(shared_env) != "0" : !device_is_cpu_;
+  m.create_pipelines(model, weights_in_shared);
   m.record();
 
   // Warm-up: run both command buffers once (lavapipe compiles a shader at its first dispatch).

@@ -4,6 +4,9 @@
 void main() {
   uint k = gl_GlobalInvocationID.x;
   uint num_samples = step_data.sizes.x;
+#ifdef MODEL_PRELUDE
+  MODEL_PRELUDE();  // every invocation of the workgroup, before any returns (it may use barrier())
+#endif
   if (k >= num_samples) return;
   int horizon = int(step_data.sizes.y);
   uint padded = step_data.sizes.z;

@@ -10,6 +10,7 @@ layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const bool kGenerate = true;  // sample the controls on the device
 layout(constant_id = 2) const int kConstantA = 1;    // the model's two integer constants
 layout(constant_id = 3) const int kConstantB = 1;    // (GpuTail; e.g. the network's hidden sizes)
+layout(constant_id = 4) const bool kWeightsInShared = false;  // model reads its weights from workgroup memory
 
 #include "common.glsl"
 #include "interface.glsl"

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -142,6 +143,23 @@ TEST_CASE("Vulkan parity: kinematic bicycle, AutoRally cost", "[vulkan][parity]"
 TEST_CASE("Vulkan parity: AutoRally network, AutoRally cost", "[vulkan][parity]") {
   check_parity(mppi::AutoRallyNetwork::load(data("autorally/models/autorally_nnet_09_12_2018.npz")),
                "network");
+}
+
+// A GPU reads the network's weights from workgroup memory (copied there once per workgroup);
+// a CPU driver from the uniform buffer. Each path is checked against the CPU backend wherever
+// the tests run: MPPI_VULKAN_WEIGHTS_IN_SHARED selects the other one.
+TEST_CASE("Vulkan parity: AutoRally network with its weights in workgroup memory and in the uniform buffer",
+          "[vulkan][parity]") {
+  const char* before = std::getenv("MPPI_VULKAN_WEIGHTS_IN_SHARED");
+  const std::string restore = before ? before : "";
+  const auto net = mppi::AutoRallyNetwork::load(data("autorally/models/autorally_nnet_09_12_2018.npz"));
+  for (const char* shared : {"1", "0"}) {
+    INFO("MPPI_VULKAN_WEIGHTS_IN_SHARED=" << shared);
+    setenv("MPPI_VULKAN_WEIGHTS_IN_SHARED", shared, 1);
+    check_parity(net, shared[0] == '1' ? "network, weights in workgroup memory" : "network, weights in the uniform buffer");
+  }
+  if (before) setenv("MPPI_VULKAN_WEIGHTS_IN_SHARED", restore.c_str(), 1);
+  else unsetenv("MPPI_VULKAN_WEIGHTS_IN_SHARED");
 }
 
 TEST_CASE("Vulkan parity: single-track Pacejka model, AutoRally cost", "[vulkan][parity]") {

@@ -13,10 +13,26 @@
 #define NET_OUT 4
 #define PAD4(n) ((((n) + 3) / 4) * 4)
 
+// The network's parameters (from P_MODEL_TAIL, a multiple of 4) in vec4s, and a copy of them in
+// workgroup memory, which the layers read when kWeightsInShared (on a GPU, the uniform buffer's
+// constant cache is too small for them). NET_W4(i): the vec4 at network float offset i.
+#define NET_VEC4S ((kHidden1 * PAD4(NET_IN) + PAD4(kHidden1) + kHidden2 * PAD4(kHidden1) + \
+                    PAD4(kHidden2) + NET_OUT * PAD4(kHidden2) + PAD4(NET_OUT)) / 4)
+shared vec4 net_shared[NET_VEC4S];
+#define NET_W4(i) (kWeightsInShared ? net_shared[((i) - P_MODEL_TAIL) >> 2] : params[(i) >> 2])
+#define NET_PARAM(i) NET_W4(i)[(i) & 3]
+void copy_network_to_shared() {
+  if (!kWeightsInShared) return;
+  for (uint i = gl_LocalInvocationIndex; i < uint(NET_VEC4S); i += gl_WorkGroupSize.x)
+    net_shared[i] = params[(P_MODEL_TAIL >> 2) + int(i)];
+  barrier();
+}
+#define MODEL_PRELUDE copy_network_to_shared
+
 // acc = bias + sum_i w[row][i] a[i] over n inputs, row stride PAD4(n), from float offset w_row.
 #define DENSE_ROW(acc, w_row, a, n)                                  \
   [[unroll]] for (int i = 0; i < PAD4(n); i += 4) {                  \
-    vec4 w4 = params[(w_row + i) >> 2];                              \
+    vec4 w4 = NET_W4(w_row + i);                                     \
     acc += w4.x * a[i];                                              \
     if (i + 1 < (n)) acc += w4.y * a[i + 1];                         \
     if (i + 2 < (n)) acc += w4.z * a[i + 2];                         \
@@ -33,19 +49,19 @@ void model_step(inout float x[NX], float steer, float throttle, float dt) {
   float a0[NET_IN] = float[NET_IN](x[6], x[3], x[4], x[5], steer, throttle);
   float h1[kHidden1];
   [[unroll]] for (int o = 0; o < kHidden1; ++o) {
-    float acc = PARAM(b1 + o);
+    float acc = NET_PARAM(b1 + o);
     DENSE_ROW(acc, w1 + o * PAD4(NET_IN), a0, NET_IN)
     h1[o] = fast_tanh(acc);
   }
   float h2[kHidden2];
   [[unroll]] for (int o = 0; o < kHidden2; ++o) {
-    float acc = PARAM(b2 + o);
+    float acc = NET_PARAM(b2 + o);
     DENSE_ROW(acc, w2 + o * PAD4(kHidden1), h1, kHidden1)
     h2[o] = fast_tanh(acc);
   }
   float d[NET_OUT];
   [[unroll]] for (int o = 0; o < NET_OUT; ++o) {
-    float acc = PARAM(b3 + o);
+    float acc = NET_PARAM(b3 + o);
     DENSE_ROW(acc, w3 + o * PAD4(kHidden2), h2, kHidden2)
     d[o] = acc;
   }
