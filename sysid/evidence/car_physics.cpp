@@ -48,6 +48,9 @@ CarConstants read_car_constants(const std::string& yaml_path) {
       {"aero_drag_kgpm", &c.aero_drag_kgpm},
       {"slip_speed_floor_mps", &c.slip_floor_mps},
       {"slip_blend", &c.slip_blend},
+      {"rear_tyre_B_scale", &c.rear_B_factor},
+      {"rear_tyre_C_scale", &c.rear_C_factor},
+      {"rear_tyre_D_scale", &c.rear_D_factor},
   };
   const std::vector<std::pair<const char*, double*>> tyre = {
       {"B", &c.mf_B}, {"C", &c.mf_C}, {"D", &c.mf_D}, {"E", &c.mf_E}, {"Sh", &c.mf_Sh}, {"Sv", &c.mf_Sv},
@@ -69,10 +72,13 @@ CarConstants read_car_constants(const std::string& yaml_path) {
   return c;
 }
 
-double tyre_mu(const CarConstants& c, double total_slip) {
+double tyre_mu(const CarConstants& c, double total_slip, bool rear) {
+  const double B = rear ? c.mf_B * c.rear_B_factor : c.mf_B;
+  const double C = rear ? c.mf_C * c.rear_C_factor : c.mf_C;
+  const double D = rear ? c.mf_D * c.rear_D_factor : c.mf_D;
   const double shifted = total_slip - c.mf_Sh;
-  const double b = c.mf_B * shifted;
-  return c.mf_D * std::sin(c.mf_C * std::atan(b - c.mf_E * (b - std::atan(shifted)))) + c.mf_Sv;
+  const double b = B * shifted;
+  return D * std::sin(C * std::atan(b - c.mf_E * (b - std::atan(shifted)))) + c.mf_Sv;
 }
 
 namespace {
@@ -80,8 +86,8 @@ namespace {
 // Friction coefficients (force / load) of one tyre along its own x and y, from the contact
 // patch velocity and the rim speed: slips relative to max(|rim speed|, floor), force opposite
 // the slip, faded in over the slip blend so that it vanishes at zero slip.
-void tyre_coefficients(const CarConstants& c, double vx, double vy, double rim_mps, double grip, double* mux,
-                       double* muy) {
+void tyre_coefficients(const CarConstants& c, bool rear, double vx, double vy, double rim_mps, double grip,
+                       double* mux, double* muy) {
   const double den = std::max(std::abs(rim_mps), c.slip_floor_mps);
   const double sx = (vx - rim_mps) / den, sy = vy / den;
   const double s = std::hypot(sx, sy);
@@ -89,7 +95,7 @@ void tyre_coefficients(const CarConstants& c, double vx, double vy, double rim_m
     *mux = *muy = 0;
     return;
   }
-  const double k = -grip * tyre_mu(c, s) * std::tanh(s / c.slip_blend) / s;
+  const double k = -grip * tyre_mu(c, s, rear) * std::tanh(s / c.slip_blend) / s;
   *mux = k * sx;
   *muy = k * sy;
 }
@@ -106,8 +112,8 @@ CarState car_derivative(const CarConstants& c, const CarState& s, const CarInput
   const double fvx = cd * vx + sd * front_lat_body, fvy = cd * front_lat_body - sd * vx;
   const double rvx = vx, rvy = vy - c.lr_m * r;
   double fmx, fmy, rmx, rmy;
-  tyre_coefficients(c, fvx, fvy, s[kWf] * c.wheel_radius_m, in.grip_scale, &fmx, &fmy);
-  tyre_coefficients(c, rvx, rvy, s[kWr] * c.wheel_radius_m, in.grip_scale, &rmx, &rmy);
+  tyre_coefficients(c, false, fvx, fvy, s[kWf] * c.wheel_radius_m, in.grip_scale, &fmx, &fmy);
+  tyre_coefficients(c, true, rvx, rvy, s[kWr] * c.wheel_radius_m, in.grip_scale, &rmx, &rmy);
   // Pitch load transfer from the moment balance about the rear contact (explicit in the
   // friction coefficients, which do not depend on the loads).
   const double wheelbase_term = c.lf_m + c.lr_m + c.cg_height_m * (fmx * cd - fmy * sd - rmx);

@@ -20,6 +20,8 @@ struct CarConstants {
   double brake_torque_ratio = 1.0;  // torque at throttle -1 (braking) / stall torque
   double rolling_coefficient = 0.05, rolling_speed_mps = 0.5, aero_drag_kgpm = 0.05;
   double slip_floor_mps = 3.0, slip_blend = 0.1;
+  // the rear tyre's B, C and D as multiples of the front's (E, Sh and Sv are shared)
+  double rear_B_factor = 1.0, rear_C_factor = 1.0, rear_D_factor = 1.0;
 };
 
 // Reads a single-track vehicle YAML (yaml-cpp); keys not given keep the defaults. Throws
@@ -44,8 +46,9 @@ struct CarInputs {
   double mass_scale = 1, yaw_inertia_scale = 1;  // payload
 };
 
-// Magic Formula friction coefficient at total slip s (before the grip scale).
-double tyre_mu(const CarConstants& c, double total_slip);
+// Magic Formula friction coefficient at total slip s (before the grip scale), of the front tyre
+// or (rear = true) of the rear one.
+double tyre_mu(const CarConstants& c, double total_slip, bool rear = false);
 
 // Tyre forces of one axle in its tyre frame and its normal load, for tests.
 struct AxleForces {

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -239,10 +240,12 @@ TEST_CASE("evidence: the car reads every constant of the nominal vehicle file an
   std::filesystem::create_directories(dir);
   SingleTrackParams q;
   std::ostringstream top, tyre;
+  std::map<std::string, double> written;
   int k = 0;
   for (const ParamField& f : param_table(q)) {
     const std::string key = f.key;
     const double v = 0.5 + 0.01 * ++k;
+    written[key] = v;
     if (key.rfind("tyre.", 0) == 0)
       tyre << "  " << key.substr(5) << ": " << v << "\n";
     else
@@ -252,6 +255,17 @@ TEST_CASE("evidence: the car reads every constant of the nominal vehicle file an
   std::ofstream(all) << top.str() << "tyre:\n" << tyre.str();
   const CarConstants every = read_car_constants(all);
   CHECK(every.brake_torque_ratio != CarConstants{}.brake_torque_ratio);
+  // the rear tyre: the front's Magic Formula with B, C, D times the file's factors
+  CHECK(every.rear_B_factor == written.at("rear_tyre_B_scale"));
+  CHECK(every.rear_C_factor == written.at("rear_tyre_C_scale"));
+  CHECK(every.rear_D_factor == written.at("rear_tyre_D_scale"));
+  for (double slip : {0.02, 0.1, 0.4}) {
+    const double B = every.mf_B * written.at("rear_tyre_B_scale"), C = every.mf_C * written.at("rear_tyre_C_scale"),
+                 D = every.mf_D * written.at("rear_tyre_D_scale"), x = slip - every.mf_Sh;
+    // the paper's form: mu = D sin(C atan(B x - E (B x - atan x))) + Sv, x = slip - Sh
+    const double closed_form = D * std::sin(C * std::atan(B * x - every.mf_E * (B * x - std::atan(x)))) + every.mf_Sv;
+    CHECK(tyre_mu(every, slip, /*rear=*/true) == Approx(closed_form).epsilon(1e-12));
+  }
 
   const std::string unknown = dir + "/unknown.yaml";
   std::ofstream(unknown) << "mass_kg: 20\nclutch_slip: 0.1\n";
