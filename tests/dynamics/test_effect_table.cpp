@@ -295,61 +295,60 @@ TEST_CASE("a grip patch is the base model with the friction curve scaled on the 
 
 namespace {
 
-// Longitudinal acceleration [m/s^2] of a car driven straight at speed v with throttle u, once
-// the rear wheel has settled on its slip (measured over 20 ms after 30 ms of settling).
-float settled_accel(const CorrectedSingleTrack& m, float v_mps, float u_throttle) {
+// Change of v_x over one step [m/s^2] of a car driven straight at speed v with the actuator
+// chains settled on throttle u.
+double one_step_accel(const CorrectedSingleTrack& m, float v_mps, float u_throttle) {
   float x[CorrectedSingleTrack::kNx];
   VehicleState s;
   s.vx_mps = v_mps;
   m.init_state(s, x);
   m.set_actuators(x, 0.f, u_throttle);
   const float u[2] = {0.f, u_throttle};
-  const float dt = 0.0002f;
-  for (int k = 0; k < 150; ++k) m.step<1>(Batch<CorrectedSingleTrack::kNx, 1>{x}, ConstBatch<2, 1>{u}, dt, nullptr);
-  const float v0 = x[state::kVx];
-  for (int k = 0; k < 100; ++k) m.step<1>(Batch<CorrectedSingleTrack::kNx, 1>{x}, ConstBatch<2, 1>{u}, dt, nullptr);
-  return (x[state::kVx] - v0) / (100 * dt);
+  const float dt = 0.001f;
+  m.step<1>(Batch<CorrectedSingleTrack::kNx, 1>{x}, ConstBatch<2, 1>{u}, dt, nullptr);
+  return (static_cast<double>(x[state::kVx]) - v_mps) / dt;
 }
 
 }  // namespace
 
-TEST_CASE("a freewheeling motor gives the (a - b v) u drive law of RC-car models", "[effects]") {
-  // A car with a DART-like motor, no rolling resistance or drag and a stiff tyre (slip of a few
-  // per mille): the settled drive force is the motor law alone. Nominal: F = a (u - v / v_nl); with the whole back-EMF braking acting
-  // only while the PWM is on (share 1): F = (a - b v) u with b = a / v_nl (Liniger et al.'s
-  // model, used by the DART and ETH RC cars); half of it: the mean of the two.
+TEST_CASE("a freewheeling motor takes the share f (1 - |u|) of the back-EMF braking away", "[effects]") {
+  // Nominal drive force F_stall (u - v / v_nl) with F_stall = T_stall / R; with the share f of
+  // the back-EMF braking acting only while the PWM is on, F_stall (u - v / v_nl ((1 - f) + f |u|)):
+  // the difference f (1 - |u|) F_stall v / v_nl (f = 1: Liniger et al.'s (a - b v) u with
+  // b = a / v_nl, the law of the DART and ETH RC cars).
   SingleTrackParams p;
-  p.mass_kg = 3.0;
-  p.yaw_inertia_kgm2 = 0.01;
-  p.tyre.B = 20.0;
-  p.tyre.C = 1.2;
-  p.tyre.D = 1.0;
-  p.tyre.E = 0.0;
-  p.tyre.Sh = 0.0;
-  p.tyre.Sv = 0.0;
-  p.cg_to_front_axle_m = 0.0805;
-  p.cg_to_rear_axle_m = 0.093;
-  p.cg_height_m = 0.0;
-  p.wheel_radius_m = 0.0325;
-  p.front_wheel_inertia_kgm2 = p.rear_wheel_inertia_kgm2 = 5e-5;
   p.stall_torque_Nm = 0.82;
+  p.wheel_radius_m = 0.0325;
   p.no_load_speed_mps = 5.27;
-  p.rolling_resistance = 0.0;
-  p.aero_drag_kgpm = 0.0;
-  const double a = p.stall_torque_Nm / p.wheel_radius_m, b = a / p.no_load_speed_mps, m = p.mass_kg;
-  EffectParams full, half;
-  full.motor_freewheel_share = 1.0;
-  half.motor_freewheel_share = 0.5;
-  const CorrectedSingleTrack nominal{SingleTrack(p)}, freewheel{SingleTrack(p), full}, mixed{SingleTrack(p), half};
-  for (const float v : {1.5f, 3.0f}) {
-    for (const float u : {0.0f, 0.15f, 0.3f}) {
-      INFO("v " << v << " m/s, u " << u);
-      const double nominal_law = a * (u - v / p.no_load_speed_mps) / m, freewheel_law = (a - b * v) * u / m;
-      CHECK(settled_accel(nominal, v, u) == Approx(nominal_law).margin(0.03 * a / m));
-      CHECK(settled_accel(freewheel, v, u) == Approx(freewheel_law).margin(0.03 * a / m));
-      CHECK(settled_accel(mixed, v, u) == Approx(0.5 * (nominal_law + freewheel_law)).margin(0.03 * a / m));
+  p.mass_kg = 1.58;
+  p.yaw_inertia_kgm2 = 0.0048;
+  const double f_stall = p.stall_torque_Nm / p.wheel_radius_m;
+  const CorrectedSingleTrack nominal{SingleTrack(p)};
+  for (const double f : {1.0, 0.4}) {
+    EffectParams e;
+    e.motor_freewheel_share = f;
+    const CorrectedSingleTrack freewheel{SingleTrack(p), e};
+    for (const float v : {1.5f, 3.0f}) {
+      for (const float u : {0.0f, 0.3f, -0.5f, 1.0f, 1.3f}) {
+        INFO("f " << f << ", v " << v << " m/s, u " << u);
+        const double duty = std::min(std::abs(static_cast<double>(u)), 1.0);
+        const double expected = f * (1 - duty) * f_stall * v / p.no_load_speed_mps / p.mass_kg;
+        CHECK(one_step_accel(freewheel, v, u) - one_step_accel(nominal, v, u) ==
+              Approx(expected).margin(0.002 * f_stall / p.mass_kg));
+      }
     }
   }
+  // With a payload the force acts on the heavier car.
+  EffectParams heavy;
+  heavy.motor_freewheel_share = 1.0;
+  heavy.mass_scale = 2.0;
+  EffectParams heavy_nominal;
+  heavy_nominal.mass_scale = 2.0;
+  CHECK(one_step_accel(CorrectedSingleTrack{SingleTrack(p), heavy}, 2.f, 0.f) -
+            one_step_accel(CorrectedSingleTrack{SingleTrack(p), heavy_nominal}, 2.f, 0.f) ==
+        Approx(f_stall * 2.0 / p.no_load_speed_mps / (2 * p.mass_kg)).margin(0.002 * f_stall / p.mass_kg));
   // Refused where the base has no motor of its own.
-  CHECK_THROWS_AS(WithEffects<KinematicBicycle>(KinematicBicycle(), full), Error);
+  EffectParams full;
+  full.motor_freewheel_share = 1.0;
+  CHECK_THROWS_AS(KinematicWithEffects(KinematicBicycle(), full), Error);
 }
