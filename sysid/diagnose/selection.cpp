@@ -147,17 +147,6 @@ std::vector<Segment> resample_blocks(const std::vector<Segment>& segs, int block
   return out;
 }
 
-// The other form of the same actuator's dynamics: a pure delay and a first-order lag of one
-// actuator give nearly the same response at small sizes, so block resamples split their votes
-// between them (empty: none).
-std::string actuator_dynamics_partner(const std::string& id) {
-  if (id == "steer_delay") return "steer_lag";
-  if (id == "steer_lag") return "steer_delay";
-  if (id == "throttle_delay") return "throttle_lag";
-  if (id == "throttle_lag") return "throttle_delay";
-  return "";
-}
-
 // Effect parameters of `ids` copied from `from`, everything else at its default.
 EffectParams only(const std::vector<std::string>& ids, const EffectParams& from) {
   EffectParams e;
@@ -273,31 +262,12 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
       sel.log.push_back(line);
     }
   }
-  // Stability of an actuator's dynamics: a resample that chose the other form (a lag for a
-  // delay) also says the actuator is slow, so its votes count for the form chosen on all the
-  // data, unless that other form was chosen there too.
-  auto stable_share = [&](int i) {
-    const CandidateReport& r = sel.candidates[static_cast<std::size_t>(i)];
-    double share = r.inclusion_frequency;
-    const std::string partner = actuator_dynamics_partner(r.id);
-    for (int j : stable_pool) {
-      const CandidateReport& o = sel.candidates[static_cast<std::size_t>(j)];
-      if (partner.empty() || o.id != partner) continue;
-      if (std::find(main.chosen.begin(), main.chosen.end(), j) != main.chosen.end()) continue;
-      share += o.inclusion_frequency;
-      std::snprintf(line, sizeof line, "stability: %s with %s (the same actuator's dynamics) in %.0f %% of the resamples",
-                    r.id.c_str(), o.id.c_str(), 100 * share);
-      sel.log.push_back(line);
-    }
-    return share;
-  };
   std::vector<std::string> named;
   for (int i : main.chosen) {
     const CandidateReport& r = sel.candidates[static_cast<std::size_t>(i)];
-    const double share = opt.stability_resamples > 0 ? stable_share(i) : 1.0;
-    if (share < opt.min_inclusion_frequency) {
+    if (opt.stability_resamples > 0 && r.inclusion_frequency < opt.min_inclusion_frequency) {
       std::snprintf(line, sizeof line, "unstable: chosen in %.0f %% of the resamples of the data (< %.0f %%)",
-                    100 * share, 100 * opt.min_inclusion_frequency);
+                    100 * r.inclusion_frequency, 100 * opt.min_inclusion_frequency);
       suspect(i, line, main.effects);
       continue;
     }
