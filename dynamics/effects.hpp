@@ -28,6 +28,13 @@
 //             load_transfer               CG height h -> h + dh (pitch load transfer)
 //             payload                     mass x m, yaw inertia x j
 //             motor_speed                 no-load speed x v (the motor's torque-speed line)
+//             motor_freewheel             share f of the drive's back-EMF braking that acts only
+//                                         while the PWM is on: the drive force becomes
+//                                         F_stall (u - v / v_nl ((1 - f) + f |u|)); f = 1 is the
+//                                         (a - b v) u motor law of RC-car models (an ESC that
+//                                         lets the motor freewheel in the off-time). Needs the
+//                                         single-track core's motor; added as a body force
+//                                         from v_x (the wheels roll without slip on average)
 //   sensor:   gyro_bias                   the yaw-rate gyro reads r + b
 //             speed_sensor_scale          the velocity sensor reads s (vx, vy)
 //             time_offset                 states are stamped t_off late against the commands.
@@ -80,6 +87,7 @@ struct EffectParams {
   double mass_scale = 1.0;           // [-] payload: mass x m
   double yaw_inertia_scale = 1.0;    // [-] payload: yaw inertia x j
   double motor_speed_scale = 1.0;    // [-] no-load speed x v
+  double motor_freewheel_share = 0.0; // [-] f: share of the back-EMF braking scaled by |u|
   double gyro_bias_radps = 0.0;      // [rad/s] measured yaw rate = r + b
   double speed_scale = 1.0;          // [-] measured vx, vy = s x true
   double time_offset_s = 0.0;        // [s] states stamped late against the commands
@@ -113,7 +121,9 @@ struct EffectParamSpec {
 // measures it on the data; sysid/diagnose/identifiability.hpp).
 enum class Excitation {
   kAny,         // any driving
-  kSteer,       // steering that changes (and turns the car)
+  kSteer,       // steering that changes (and turns the car). Also what a steering trim and a
+                // gyro bias need: at one steering command the trim, the steering gain, the tyre
+                // and a yaw-rate bias all give one number, the steady yaw-rate error there
   kThrottle,    // throttle that changes (and changes the speed)
   kCornering,   // lateral acceleration towards the tyres' limit
   kSpeedRange,  // a range of speeds (speed-dependent forces)
@@ -162,7 +172,7 @@ inline const std::vector<EffectSpec>& effect_table() {
       {"throttle_lag", "first-order throttle / motor response", H::kActuator,
        {{"throttle_lag_s", &E::throttle_lag_s, "s", kNonNeg, 0.0, 1.0, 0.05}}, {0.03, 0.06, 0.1, 0.2, 0.4}, DataGrid::kNone, X::kThrottle},
       {"steer_offset", "steering bias (trim)", H::kActuator,
-       {{"steer_offset", &E::steer_offset, "1 (normalised steer)", kAny, -0.4, 0.4, 0.02}}, {}, DataGrid::kNone, X::kAny},
+       {{"steer_offset", &E::steer_offset, "1 (normalised steer)", kAny, -0.4, 0.4, 0.02}}, {}, DataGrid::kNone, X::kSteer},
       {"steer_gain", "steering scale (servo / linkage gain)", H::kActuator,
        {{"steer_gain", &E::steer_gain, "1", kAny, 0.3, 2.0, 0.1}}, {0.7, 1.0, 1.3}, DataGrid::kNone, X::kSteer},
       {"throttle_offset", "throttle bias / motor dead band", H::kActuator,
@@ -205,8 +215,12 @@ inline const std::vector<EffectSpec>& effect_table() {
         {"yaw_inertia_scale", &E::yaw_inertia_scale, "1", kScale, 0.5, 2.5, 0.1}}, {0.8, 1.2, 1.5}, DataGrid::kNone, X::kThrottle},
       {"motor_speed", "the drivetrain's torque-speed line: no-load speed x v", H::kChassis,
        {{"motor_speed_scale", &E::motor_speed_scale, "1", kScale, 0.3, 3.0, 0.1}}, {0.6, 1.0, 1.5}, DataGrid::kNone, X::kSpeedRange},
+      {"motor_freewheel", "the motor's back-EMF braking acts only while the PWM is on: F_stall (u - v/v_nl ((1-f) + f|u|))",
+       H::kChassis,
+       {{"freewheel_share", &E::motor_freewheel_share, "1", closed(0.0, 1.0), 0.0, 1.0, 0.1}}, {0.3, 0.7},
+       DataGrid::kNone, X::kThrottle},
       {"gyro_bias", "sensor fault: the yaw-rate gyro reads r + b", H::kSensor,
-       {{"gyro_bias_radps", &E::gyro_bias_radps, "rad/s", kAny, -0.5, 0.5, 0.01}}, {}, DataGrid::kNone, X::kAny},
+       {{"gyro_bias_radps", &E::gyro_bias_radps, "rad/s", kAny, -0.5, 0.5, 0.01}}, {}, DataGrid::kNone, X::kSteer},
       {"speed_sensor_scale", "sensor fault: the velocity sensor reads s x (vx, vy)", H::kSensor,
        {{"speed_scale", &E::speed_scale, "1", kScale, 0.5, 1.5, 0.02}}, {}, DataGrid::kNone, X::kAny},
       {"time_offset", "sensor fault: states stamped t late against the commands (negative: early)", H::kSensor,

@@ -88,6 +88,9 @@ class WithEffects {
     drag_per_kg_ = static_cast<float>(effects_.aero_drag_kgpm / m);
     roll_per_kg_ = static_cast<float>(effects_.rolling_force_N / m);
     visc_per_kg_ = static_cast<float>(effects_.rolling_viscous_Nspm / m);
+    if constexpr (kChassisEffects)  // the motor's back-EMF force at speed v_nl: F_stall = T_stall / R
+      freewheel_per_kg_ = static_cast<float>(effects_.motor_freewheel_share * car.stall_torque_Nm /
+                                             (car.wheel_radius_m * m * car.no_load_speed_mps));
     grade_x_ = static_cast<float>(g * effects_.grade_x);
     grade_y_ = static_cast<float>(g * effects_.grade_y);
     change_time_ = static_cast<float>(effects_.grip_change_time_s);
@@ -170,8 +173,11 @@ class WithEffects {
       const float vx = x[state::kVx][j];
       float sy, cy;
       fast_sincos(x[state::kYaw][j], &sy, &cy);
+      // motor_freewheel: the share f of the base's back-EMF braking F_stall v / v_nl that the
+      // command's off-time takes away, f (1 - |u|) F_stall v / v_nl.
+      const float duty = std::min(std::abs(applied[control::kThrottle * W + j]), 1.f);
       ax[j] = -drag_per_kg_ * vx * std::abs(vx) - roll_per_kg_ * phys::tanh(vx * 2.f) - visc_per_kg_ * vx -
-              (grade_x_ * cy + grade_y_ * sy);
+              (grade_x_ * cy + grade_y_ * sy) + freewheel_per_kg_ * (1.f - duty) * vx;
       ay[j] = -(-grade_x_ * sy + grade_y_ * cy);
       other_w[j] = other_grip_weight(x[kTime][j], x[state::kX][j], x[state::kY][j]);
       before_lanes += other_w[j] == 0.f;
@@ -273,7 +279,7 @@ class WithEffects {
   Base nominal_;
   EffectParams effects_;
   Base before_, after_;
-  float drag_per_kg_ = 0, roll_per_kg_ = 0, visc_per_kg_ = 0, grade_x_ = 0, grade_y_ = 0, change_time_ = 0;
+  float drag_per_kg_ = 0, roll_per_kg_ = 0, visc_per_kg_ = 0, freewheel_per_kg_ = 0, grade_x_ = 0, grade_y_ = 0, change_time_ = 0;
   bool grip_changes_ = false, patch_ = false;
   float patch_x_ = 0, patch_y_ = 0, patch_r_ = 0;
   float gain_ = 1, offset_ = 0, steer_cubic_ = 0, left_gain_ = 1, right_gain_ = 1;  // steering map

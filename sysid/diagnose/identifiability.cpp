@@ -102,8 +102,13 @@ std::string range_limit_shortfall(const EffectSpec& spec, const EffectParams& fi
     if (static_cast<int>(i) < grid_param_count(spec.data_grid)) continue;  // searched over the data, not bounded
     const EffectParamSpec& p = spec.params[i];
     const double v = fitted.*(p.member), d = defaults.*(p.member), tol = margin * (p.hi - p.lo);
-    const bool at_lo = v <= p.lo + tol && std::abs(d - p.lo) > tol;
-    const bool at_hi = v >= p.hi - tol && std::abs(d - p.hi) > tol;
+    // An end of the search range that is also a closed end of the physical range (a share of 1)
+    // bounds the physics, not the search: a value there is an estimate, not a bound.
+    const bool lo_closed = p.valid.bounds == Bounds::kClosed || p.valid.bounds == Bounds::kOpenHigh;
+    const bool hi_closed = p.valid.bounds == Bounds::kClosed || p.valid.bounds == Bounds::kOpenLow;
+    const bool lo_physical = lo_closed && p.valid.lo == p.lo, hi_physical = hi_closed && p.valid.hi == p.hi;
+    const bool at_lo = v <= p.lo + tol && std::abs(d - p.lo) > tol && !lo_physical;
+    const bool at_hi = v >= p.hi - tol && std::abs(d - p.hi) > tol && !hi_physical;
     if (at_lo || at_hi) {
       char buf[200];
       std::snprintf(buf, sizeof buf, "%s = %.4g sits at the %s end of its search range [%.4g, %.4g]", p.name, v,

@@ -28,7 +28,8 @@ ExcitationLevels measure_excitation(const DiagData& d, const std::vector<char>& 
 std::string excitation_shortfall(Excitation needs, const ExcitationLevels& levels);
 
 // Empty unless a fitted parameter of `spec` lies within `margin` (fraction of the search range)
-// of an end of its search range that is not its default; then which one and where.
+// of an end of its search range that is not its default and not a closed end of its physical
+// range (a share at 1 is an estimate); then which one and where.
 std::string range_limit_shortfall(const EffectSpec& spec, const EffectParams& fitted, double margin = 0.01);
 
 }  // namespace mppi::diagnose

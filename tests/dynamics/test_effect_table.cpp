@@ -292,3 +292,63 @@ TEST_CASE("a grip patch is the base model with the friction curve scaled on the 
   both.grip_scale = 0.8;
   CHECK_THROWS_WITH(CorrectedSingleTrack(SingleTrack(), both), Catch::Contains("cannot be combined"));
 }
+
+namespace {
+
+// Change of v_x over one step [m/s^2] of a car driven straight at speed v with the actuator
+// chains settled on throttle u.
+double one_step_accel(const CorrectedSingleTrack& m, float v_mps, float u_throttle) {
+  float x[CorrectedSingleTrack::kNx];
+  VehicleState s;
+  s.vx_mps = v_mps;
+  m.init_state(s, x);
+  m.set_actuators(x, 0.f, u_throttle);
+  const float u[2] = {0.f, u_throttle};
+  const float dt = 0.001f;
+  m.step<1>(Batch<CorrectedSingleTrack::kNx, 1>{x}, ConstBatch<2, 1>{u}, dt, nullptr);
+  return (static_cast<double>(x[state::kVx]) - v_mps) / dt;
+}
+
+}  // namespace
+
+TEST_CASE("a freewheeling motor takes the share f (1 - |u|) of the back-EMF braking away", "[effects]") {
+  // Nominal drive force F_stall (u - v / v_nl) with F_stall = T_stall / R; with the share f of
+  // the back-EMF braking acting only while the PWM is on, F_stall (u - v / v_nl ((1 - f) + f |u|)):
+  // the difference f (1 - |u|) F_stall v / v_nl (f = 1: Liniger et al.'s (a - b v) u with
+  // b = a / v_nl, the law of the DART and ETH RC cars).
+  SingleTrackParams p;
+  p.stall_torque_Nm = 0.82;
+  p.wheel_radius_m = 0.0325;
+  p.no_load_speed_mps = 5.27;
+  p.mass_kg = 1.58;
+  p.yaw_inertia_kgm2 = 0.0048;
+  const double f_stall = p.stall_torque_Nm / p.wheel_radius_m;
+  const CorrectedSingleTrack nominal{SingleTrack(p)};
+  for (const double f : {1.0, 0.4}) {
+    EffectParams e;
+    e.motor_freewheel_share = f;
+    const CorrectedSingleTrack freewheel{SingleTrack(p), e};
+    for (const float v : {1.5f, 3.0f}) {
+      for (const float u : {0.0f, 0.3f, -0.5f, 1.0f, 1.3f}) {
+        INFO("f " << f << ", v " << v << " m/s, u " << u);
+        const double duty = std::min(std::abs(static_cast<double>(u)), 1.0);
+        const double expected = f * (1 - duty) * f_stall * v / p.no_load_speed_mps / p.mass_kg;
+        CHECK(one_step_accel(freewheel, v, u) - one_step_accel(nominal, v, u) ==
+              Approx(expected).margin(0.002 * f_stall / p.mass_kg));
+      }
+    }
+  }
+  // With a payload the force acts on the heavier car.
+  EffectParams heavy;
+  heavy.motor_freewheel_share = 1.0;
+  heavy.mass_scale = 2.0;
+  EffectParams heavy_nominal;
+  heavy_nominal.mass_scale = 2.0;
+  CHECK(one_step_accel(CorrectedSingleTrack{SingleTrack(p), heavy}, 2.f, 0.f) -
+            one_step_accel(CorrectedSingleTrack{SingleTrack(p), heavy_nominal}, 2.f, 0.f) ==
+        Approx(f_stall * 2.0 / p.no_load_speed_mps / (2 * p.mass_kg)).margin(0.002 * f_stall / p.mass_kg));
+  // Refused where the base has no motor of its own.
+  EffectParams full;
+  full.motor_freewheel_share = 1.0;
+  CHECK_THROWS_AS(KinematicWithEffects(KinematicBicycle(), full), Error);
+}

@@ -191,6 +191,14 @@ TEST_CASE("a parameter at the end of its search range is a bound, not an estimat
   e = {};
   e.steer_slew_s = 3.0;
   CHECK_FALSE(range_limit_shortfall(effect_spec("steer_rate_limit"), e).empty());
+  // A share's search range ends where its physical range does (closed [0, 1]): a whole
+  // freewheeling motor is an estimate, not a bound.
+  e = {};
+  e.motor_freewheel_share = 1.0;
+  CHECK(range_limit_shortfall(effect_spec("motor_freewheel"), e).empty());
+  // A steering trim and a gyro bias need steering that varies, like the steering gain.
+  CHECK(effect_spec("steer_offset").needs == Excitation::kSteer);
+  CHECK(effect_spec("gyro_bias").needs == Excitation::kSteer);
 }
 
 TEST_CASE("an effect that the held-out part contradicts is not named and no model is written", "[diagnose]") {
