@@ -2,6 +2,7 @@
 // The one coarse virtual boundary of the data path: roll out a batch of control sequences
 // from one start state and return each sequence's total running cost. Behind it, models and
 // costs are templates inlined over structure-of-arrays batches (see cpu_backend.hpp).
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -44,6 +45,20 @@ struct IterationOutput {
   int valid_samples = 0;     // samples with a finite S_k (0: next is not usable)
 };
 
+// out[r * n + j] = all[r * padded + samples[j]] for the rows r in [0, rows) of a T x nu x padded
+// array of sampled controls (n = samples.size()). False (out unspecified) if all or out is too
+// small or a sample is outside [0, num_samples).
+inline bool copy_sample_columns(std::span<const float> all, std::size_t rows, std::size_t padded,
+                                int num_samples, std::span<const int> samples, std::span<float> out) {
+  const std::size_t n = samples.size();
+  if (all.size() < rows * padded || out.size() < rows * n) return false;
+  for (int k : samples)
+    if (k < 0 || k >= num_samples) return false;
+  for (std::size_t r = 0; r < rows; ++r)
+    for (std::size_t j = 0; j < n; ++j) out[r * n + j] = all[r * padded + static_cast<std::size_t>(samples[j])];
+  return true;
+}
+
 class Backend {
  public:
   virtual ~Backend() = default;
@@ -64,16 +79,9 @@ class Backend {
   // out[(t * nu + c) * n + j], n = samples.size(). False (out unspecified) if the backend keeps
   // none, a sample is out of range or out is too small.
   virtual bool copy_sampled_controls(std::span<const int> samples, std::span<float> out) const {
-    const std::span<const float> all = sampled_controls();
     const RolloutShape& s = shape();
-    const std::size_t padded = static_cast<std::size_t>(s.padded_samples), n = samples.size();
-    const std::size_t rows = static_cast<std::size_t>(s.horizon) * static_cast<std::size_t>(s.num_controls);
-    if (all.size() < rows * padded || out.size() < rows * n) return false;
-    for (int k : samples)
-      if (k < 0 || k >= s.num_samples) return false;
-    for (std::size_t r = 0; r < rows; ++r)
-      for (std::size_t j = 0; j < n; ++j) out[r * n + j] = all[r * padded + static_cast<std::size_t>(samples[j])];
-    return true;
+    return copy_sample_columns(sampled_controls(), static_cast<std::size_t>(s.horizon) * s.num_controls,
+                               static_cast<std::size_t>(s.padded_samples), s.num_samples, samples, out);
   }
 
   // The cost changed while the controller runs (between iterations, from the thread that

@@ -225,14 +225,8 @@ class Controller {
   // backend draws them again on demand. False if none are kept or an argument is out of range.
   bool copy_sampled_controls(std::span<const int> samples, std::span<float> out) const {
     if (backend_->has_iterate()) return backend_->copy_sampled_controls(samples, out);
-    const std::size_t padded = static_cast<std::size_t>(backend_->shape().padded_samples), n = samples.size();
-    const std::size_t rows = nominal_.size();
-    if (controls_.size() < rows * padded || out.size() < rows * n) return false;
-    for (int k : samples)
-      if (k < 0 || k >= options_.num_samples) return false;
-    for (std::size_t r = 0; r < rows; ++r)
-      for (std::size_t j = 0; j < n; ++j) out[r * n + j] = controls_[r * padded + static_cast<std::size_t>(samples[j])];
-    return true;
+    return copy_sample_columns(controls_, nominal_.size(), static_cast<std::size_t>(backend_->shape().padded_samples),
+                               options_.num_samples, samples, out);
   }
   std::span<const float> sampled_costs() const { return std::span(costs_).first(options_.num_samples); }
   std::span<const float> weights() const { return std::span(weights_).first(options_.num_samples); }

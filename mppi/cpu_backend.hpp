@@ -345,8 +345,8 @@ class CpuBackend final : public Backend {
     detail::ChunkTotals* totals = totals_.data();
     runner_.run(chunks, 1, [&](int chunk, int slot) {
       const int k0 = chunk * kChunk;
-      detail::iterate_chunk(model_, cost_, args, k0,
-                            work + work_floats * static_cast<std::size_t>(slot), costs + k0, expw + k0, partial + stride * static_cast<std::size_t>(chunk),
+      detail::iterate_chunk(model_, cost_, args, k0, work + work_floats * static_cast<std::size_t>(slot),
+                            costs + k0, expw + k0, partial + stride * static_cast<std::size_t>(chunk),
                             totals + chunk);
     });
     detail::combine_chunks(totals, partial, stride, chunks, shape_.horizon * D::kNu,
@@ -371,7 +371,9 @@ class CpuBackend final : public Backend {
     if (!drawn_ || out.size() < rows * n) return false;
     for (int k : samples)
       if (k < 0 || k >= shape_.num_samples) return false;
-    if (controls_fresh_) return Backend::copy_sampled_controls(samples, out);
+    if (controls_fresh_)
+      return copy_sample_columns({controls_.get(), rows * static_cast<std::size_t>(shape_.padded_samples)}, rows,
+                                 static_cast<std::size_t>(shape_.padded_samples), shape_.num_samples, samples, out);
     const detail::IterationArgs a = drawn_args();
     int block = -1;
     for (std::size_t j = 0; j < n; ++j) {
