@@ -9,6 +9,8 @@
 
 namespace mppi::evidence {
 
+constexpr double kDriverPeriod_s = 0.02;  // the drivers decide at 50 Hz
+
 Driver::Driver(const std::string& kind, const sim::Track& track, std::uint64_t seed, double speed_min_mps,
                double speed_max_mps, double wheelbase_m, double max_steer_rad)
     : kind_(kind), track_(track), rng_(seed * 2654435761ULL + 97), speed_min_(speed_min_mps),
@@ -21,6 +23,7 @@ void Driver::respawned() {
   have_hint_ = false;
   integral_ = 0;
   hand_ = 0;
+  foot_ = 0;
   steer_memory_.clear();
 }
 
@@ -114,8 +117,20 @@ std::pair<double, double> Driver::command(const DriverView& v) {
   // Speed: feed-forward for the car's steady speed, PI on the error, brakes when too fast.
   const double vt = target_speed(v, s);
   const double err = vt - v.speed_mps;
-  integral_ = std::clamp(integral_ + err * 0.02, -3.0, 3.0);
-  const double throttle = std::clamp(0.05 * vt + 0.25 * err + 0.05 * integral_, -0.9, 0.9);
+  integral_ = std::clamp(integral_ + err * kDriverPeriod_s, -3.0, 3.0);
+  double throttle = std::clamp(0.05 * vt + 0.25 * err + 0.05 * integral_, -0.9, 0.9);
+  if (kind_ == "human") {
+    // A human's foot: it squeezes the throttle at low speed (no full throttle from rest), lifts
+    // when the car yaws beyond what the road's bend asks (the rear stepping out) and moves at
+    // most 2 per second (about half a second from idle to full).
+    throttle = std::min(throttle, 0.35 + 0.12 * v.speed_mps);
+    const double bend_radps = v.speed_mps * curvature_ahead(s, 2.0);
+    const double excess_radps = std::abs(v.yaw_rate_radps) - (1.15 * bend_radps + 0.15);
+    if (excess_radps > 0) throttle = std::min(throttle, std::max(0.0, 0.3 - 0.6 * excess_radps));
+    const double step = 2.0 * kDriverPeriod_s;
+    foot_ = std::clamp(throttle, foot_ - step, foot_ + step);
+    throttle = foot_;
+  }
   return {steer, throttle};
 }
 

@@ -1,8 +1,9 @@
 #pragma once
 // The evidence generator's drivers (50 Hz): pure pursuit with steering dither and a random
 // target-speed schedule; and a human-like driver that slows for the curvature ahead with its own
-// cornering nerve, reacts late and steers with a slow, imperfect hand. Both use only what a
-// driver sees: the car's pose and speed and the track's centreline.
+// cornering nerve, reacts late and steers with a slow, imperfect hand, eases onto the throttle and
+// lifts when the car yaws faster than the road bends (the rear stepping out). Both use only what
+// a driver sees or feels: the car's pose, speed and yaw rate, and the track's centreline.
 #include <cstdint>
 #include <random>
 #include <string>
@@ -15,6 +16,7 @@ namespace mppi::evidence {
 
 struct DriverView {
   double t_s, x_m, y_m, yaw_rad, speed_mps;
+  double yaw_rate_radps = 0;  // felt, not used by the pursuit driver
 };
 
 class Driver {
@@ -42,6 +44,7 @@ class Driver {
   double schedule_speed_ = 5, schedule_until_s_ = -1, dither_ = 0, dither_until_s_ = -1;
   // human: nerve (lateral acceleration it accepts), late and smoothed steering
   double nerve_mps2_ = 4, nerve_until_s_ = -1, hand_ = 0;
+  double foot_ = 0;  // human: the throttle pedal, moved at a human rate
   std::vector<double> steer_memory_;  // reaction delay of the human
 };
 

@@ -119,7 +119,7 @@ EvidenceResult generate_evidence(const EvidenceOptions& o, const std::string& cs
   history.push_back({s, segment});
   for (int k = 0; k < rows; ++k) {
     const double t = k * o.log_dt_s;
-    const auto cmd = driver.command({t, s[kX], s[kY], s[kYaw], std::hypot(s[kVx], s[kVy])});
+    const auto cmd = driver.command({t, s[kX], s[kY], s[kYaw], std::hypot(s[kVx], s[kVy]), s[kR]});
     commands[static_cast<std::size_t>(k)] = cmd;
     chain.issue(t, cmd.first, cmd.second);
     for (int i = 0; i < substeps; ++i) {
