@@ -326,7 +326,7 @@ py::dict diagnose(const std::string& log, const std::string& params, const std::
                              py::arg("magnitude") = m.magnitude, py::arg("rms") = m.rms, py::arg("z") = m.z,
                              py::arg("unit") = m.unit));
   for (const auto& c : r.selection.candidates)
-    candidates.append(py::dict(py::arg("id") = c.id, py::arg("params") = params_list(c.params),
+    candidates.append(py::dict(py::arg("id") = c.id, py::arg("joint_of") = c.joint_of, py::arg("params") = params_list(c.params),
                                py::arg("val_improvement") = c.val_improvement, py::arg("bic_delta") = c.bic_delta,
                                py::arg("heldout_improvement") = c.heldout_improvement,
                                py::arg("selected") = c.selected, py::arg("round_selected") = c.round_selected));

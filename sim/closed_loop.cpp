@@ -51,10 +51,13 @@ std::string model_file(const std::string& params_file, const std::string& weight
 // its concrete type, with how it reads a plant's state: a plant of the same corrected model is
 // copied whole; any other as the nominal model reads it, with time 0 and the actuator chains at
 // rest.
+// With pure_delays_outside, the model is built without the file's pure command delays (a plant
+// realises them exactly, by its actuators; a controller's model keeps its chain of delay stages).
 template <class F>
-auto visit_corrected(const std::string& path, const char* flag, F&& f) {
+auto visit_corrected(const std::string& path, const char* flag, F&& f, bool pure_delays_outside = false) {
   if (path.empty()) throw Error(std::string("--") + flag + " corrected needs --" + flag + "-params FILE");
-  const CorrectedModelFile file = load_corrected_model(path);
+  CorrectedModelFile file = load_corrected_model(path);
+  if (pure_delays_outside) file.effects.steer_delay_s = file.effects.throttle_delay_s = 0.0;
   using Result = decltype(f(std::declval<const CorrectedSingleTrack&>(),
                             std::function<void(const float*, int, float*)>()));
   std::optional<Result> result;
@@ -382,10 +385,19 @@ RunSummary run_closed_loop(const ClosedLoopConfig& config) {
         load_single_track_params(model_file<models::SingleTrackModel>(config.plant_params_yaml, config.network_npz));
     return run_with_plant(config, SingleTrackOnSurface(params, std::move(surface)), track, cost);
   }
-  if (config.plant == kCorrectedModel)
-    return visit_corrected(config.plant_params_yaml, "plant", [&](const auto& model, auto) {
-      return run_with_plant(config, model, track, cost);
-    });
+  if (config.plant == kCorrectedModel) {
+    // The plant's actuators delay the commands exactly, by the file's pure delays.
+    ClosedLoopConfig plant_config = config;
+    if (!config.plant_params_yaml.empty()) {
+      const EffectParams e = load_corrected_model(config.plant_params_yaml).effects;
+      plant_config.actuators.steer_delay_s = static_cast<float>(e.steer_delay_s);
+      plant_config.actuators.throttle_delay_s = static_cast<float>(e.throttle_delay_s);
+    }
+    return visit_corrected(
+        config.plant_params_yaml, "plant",
+        [&](const auto& model, auto) { return run_with_plant(plant_config, model, track, cost); },
+        /*pure_delays_outside=*/true);
+  }
   return with_model(config.plant, [&]<class D>() {
     return run_with_plant(config, D::load(model_file<D>(config.plant_params_yaml, config.network_npz)), track, cost);
   }, "plant");

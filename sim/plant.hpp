@@ -1,7 +1,8 @@
 #pragma once
 // The simulated car: any vehicle model integrated at a fixed high rate (500 Hz by default),
 // behind actuators with rate limits (a servo cannot jump from full left to full right, and
-// the throttle channel has its own slew limit). Commands are clamped to the actuator range.
+// the throttle channel has its own slew limit), each optionally after a pure transport delay.
+// Commands are clamped to the actuator range.
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -18,6 +19,9 @@ struct ActuatorLimits {
   float throttle_rate_per_s = 10.0f; // max |d throttle / dt| [1/s]
   float steer_min = -1.f, steer_max = 1.f;
   float throttle_min = -1.f, throttle_max = 1.f;
+  // Pure transport delay of each command [s] (rounded to the integration step): the actuator
+  // acts on the command given this long before. Before any command: at rest (0).
+  float steer_delay_s = 0.f, throttle_delay_s = 0.f;
 };
 
 template <VehicleDynamics D>
@@ -27,11 +31,18 @@ class Plant {
       : model_(std::move(model)), limits_(limits), dt_s_(dt_s),
         scratch_(std::max<std::size_t>(1, model_.scratch_floats(1))) {
     if (!(dt_s > 0.f)) throw Error("Plant: integration step must be > 0");
+    if (!(limits.steer_delay_s >= 0.f && limits.throttle_delay_s >= 0.f && limits.steer_delay_s < 10.f &&
+          limits.throttle_delay_s < 10.f))
+      throw Error("Plant: command delays must be in [0, 10) s");
+    steer_delay_steps_ = static_cast<std::size_t>(std::lround(limits.steer_delay_s / dt_s));
+    throttle_delay_steps_ = static_cast<std::size_t>(std::lround(limits.throttle_delay_s / dt_s));
+    issued_.assign(std::max(steer_delay_steps_, throttle_delay_steps_) + 1, Control{});
   }
 
   void reset(const VehicleState& s) {
     model_.init_state(s, x_);
     applied_ = Control{};
+    std::fill(issued_.begin(), issued_.end(), Control{});
     time_s_ = 0.0;
   }
   // Set the full model state (e.g. to restore a snapshot).
@@ -44,9 +55,14 @@ class Plant {
     const float throttle_target =
         std::clamp(command.throttle, limits_.throttle_min, limits_.throttle_max);
     for (int i = 0; i < substeps; ++i) {
-      applied_.steer = slew(applied_.steer, steer_target, limits_.steer_rate_per_s * dt_s_);
-      applied_.throttle =
-          slew(applied_.throttle, throttle_target, limits_.throttle_rate_per_s * dt_s_);
+      // The commands issued steps ago (a ring of the last max-delay + 1 steps).
+      head_ = (head_ + 1) % issued_.size();
+      issued_[head_] = Control{steer_target, throttle_target};
+      const std::size_t n = issued_.size();
+      const float steer_in = issued_[(head_ + n - steer_delay_steps_) % n].steer;
+      const float throttle_in = issued_[(head_ + n - throttle_delay_steps_) % n].throttle;
+      applied_.steer = slew(applied_.steer, steer_in, limits_.steer_rate_per_s * dt_s_);
+      applied_.throttle = slew(applied_.throttle, throttle_in, limits_.throttle_rate_per_s * dt_s_);
       float u[D::kNu] = {};
       u[control::kSteer] = applied_.steer;
       u[control::kThrottle] = applied_.throttle;
@@ -74,6 +90,9 @@ class Plant {
   float x_[D::kNx] = {};
   Control applied_;
   double time_s_ = 0.0;
+  std::vector<Control> issued_;  // ring of the commands of the last steps, for the delays
+  std::size_t head_ = 0;
+  std::size_t steer_delay_steps_ = 0, throttle_delay_steps_ = 0;
 };
 
 }  // namespace mppi::sim

@@ -150,6 +150,7 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
   for (const auto& c : res.selection.candidates) {
     json e;
     e["id"] = c.id;
+    if (!c.joint_of.empty()) e["joint_of"] = c.joint_of;
     json ps;
     for (const auto& p : c.params) ps[p.name] = {{"value", num(p.value)}, {"stddev", num(p.stddev)}, {"unit", p.unit}};
     e["params"] = ps;

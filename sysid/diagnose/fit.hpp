@@ -70,6 +70,9 @@ struct SelectionOptions {
   // Forward validation: the last part of the training data (in time) judges what the earlier
   // part fitted, so an effect must hold on data that come later.
   double validation_fraction = 0.3;
+  // A candidate that changes the later block's validation cost by less than this share cannot be
+  // judged there; the earlier fold (the fit part's first half judging its second half) does.
+  double inconclusive_share = 0.03;
   // Stability selection: the selection is repeated on block-bootstrap resamples of the fit
   // segments; an effect is named only when chosen in at least this share of them.
   int stability_resamples = 6;
@@ -82,10 +85,14 @@ struct SelectionOptions {
   // Parsimony: a candidate with fewer parameters is preferred when its validation improvement is
   // at least this share of the best one's.
   double parsimony_share = 0.9;
+  // Among near-best candidates of as many parameters, one whose BIC on the fit part is lower by
+  // at least this ("strong evidence" on the Kass-Raftery scale) goes first.
+  double strong_bic_evidence = 6.0;
 };
 
 struct CandidateReport {
   std::string id;
+  std::vector<std::string> joint_of;  // a joint candidate: the library effects fitted together (else empty)
   std::vector<ParamEstimate> params;  // first-round fit (alone on the nominal)
   double val_improvement = 0;         // relative validation-cost reduction (first round)
   double bic_delta = 0;               // BIC(nominal + effect) - BIC(nominal), first round

@@ -43,8 +43,12 @@ class WrappedFamily final : public ModelFamily {
   }
   const std::string& name() const override { return file_.nominal_model; }
   std::unique_ptr<ReplayModel> make(const EffectParams& e) const override {
-    auto m = std::make_unique<ReplayModelOf<WithEffects<Base>>>(WithEffects<Base>(nominal_, e));
+    EffectParams chained = e;  // the delays are the replay's (exact); the rest is the member's
+    chained.steer_delay_s = 0.0;
+    chained.throttle_delay_s = 0.0;
+    auto m = std::make_unique<ReplayModelOf<WithEffects<Base>>>(WithEffects<Base>(nominal_, chained));
     m->sensor = SensorFaults::of(e);
+    m->command_delay = {e.steer_delay_s, e.throttle_delay_s};
     return m;
   }
   bool supports(const std::string& effect_id) const override {

@@ -21,10 +21,19 @@ struct SensorFaults {
   static SensorFaults of(const EffectParams& e) { return {e.gyro_bias_radps, e.speed_scale, e.time_offset_s}; }
 };
 
+// Pure command delays [s] that the replay realises exactly, by reading each command that much
+// earlier in the recording; the member's own delay stages are then off. (A controller's rollout
+// has no recorded past to read and realises the same delay with its chain of delay stages.)
+struct CommandDelays {
+  double steer_s = 0.0;
+  double throttle_s = 0.0;
+};
+
 class ReplayModel {
  public:
   static constexpr int kMaxStates = 64;
   SensorFaults sensor;
+  CommandDelays command_delay;
   virtual ~ReplayModel() = default;
   virtual int states() const = 0;        // <= kMaxStates
   virtual int time_index() const = 0;    // the state that holds time [s] (grip changes)

@@ -37,19 +37,20 @@ void predict_segment(const ReplayModel& model, const DiagData& d, const Segment&
   auto true_vx = [&](std::size_t k) { return static_cast<float>(d.vx[k] * inv_scale); };
   auto true_vy = [&](std::size_t k) { return static_cast<float>(d.vy[k] * inv_scale); };
   auto true_r = [&](std::size_t k) { return static_cast<float>(d.r[k] - sf.gyro_bias_radps); };
-  const double shift_rows = sf.time_offset_s / d.dt_s;
-  auto command_over = [&](std::size_t k, float* u) {
-    if (shift_rows == 0.0) {
-      u[0] = static_cast<float>(d.steer_over(k));
-      u[1] = static_cast<float>(d.throttle_over(k));
-      return;
-    }
+  // Each command is read this many rows earlier: the states' time offset plus the channel's pure
+  // delay. A held command shifted by a fraction of a row averages over two recorded ones.
+  const double steer_shift_rows = (sf.time_offset_s + model.command_delay.steer_s) / d.dt_s;
+  const double throttle_shift_rows = (sf.time_offset_s + model.command_delay.throttle_s) / d.dt_s;
+  auto shifted = [&](std::size_t k, double shift_rows, double (DiagData::*over)(std::size_t) const) {
+    if (shift_rows == 0.0) return (d.*over)(k);
     const double pos = static_cast<double>(k) - shift_rows;
     const double lo = std::floor(pos), w = pos - lo;
     const auto at = [&](double i) { return static_cast<std::size_t>(std::clamp(i, 0.0, static_cast<double>(d.rows() - 1))); };
-    const std::size_t i0 = at(lo), i1 = at(lo + 1);
-    u[0] = static_cast<float>((1 - w) * d.steer_over(i0) + w * d.steer_over(i1));
-    u[1] = static_cast<float>((1 - w) * d.throttle_over(i0) + w * d.throttle_over(i1));
+    return (1 - w) * (d.*over)(at(lo)) + w * (d.*over)(at(lo + 1));
+  };
+  auto command_over = [&](std::size_t k, float* u) {
+    u[0] = static_cast<float>(shifted(k, steer_shift_rows, &DiagData::steer_over));
+    u[1] = static_cast<float>(shifted(k, throttle_shift_rows, &DiagData::throttle_over));
   };
   vs.x_m = static_cast<float>(d.x[k0]);
   vs.y_m = static_cast<float>(d.y[k0]);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <limits>
 #include <random>
 
@@ -19,11 +20,32 @@ double heldout_1s_normalized_rmse(const ReplayModel& m, const DiagData& d, const
   return horizon_metrics(m, d, mask, {1.0}, 5, o)[0].normalized_rmse;
 }
 
+// The parameters of these candidates that a joint least-squares refit moves: all but a change
+// time, which was searched over the data.
+std::vector<ParamSpec> joint_free_params(const std::vector<const EffectSpec*>& cands, const std::vector<int>& chosen) {
+  std::vector<ParamSpec> free;
+  for (int i : chosen) {
+    const EffectSpec& s = *cands[static_cast<std::size_t>(i)];
+    for (std::size_t j = 0; j < s.params.size(); ++j)
+      if (!(s.data_grid == DataGrid::kTime && j == 0)) free.push_back(s.params[j]);
+  }
+  return free;
+}
+
+// The effect parameters of the chosen candidates only (the others at their defaults).
+EffectParams only_chosen(const std::vector<const EffectSpec*>& cands, const std::vector<int>& chosen, const EffectParams& from) {
+  EffectParams e;
+  for (int i : chosen)
+    for (const EffectParamSpec& p : cands[static_cast<std::size_t>(i)]->params) e.*(p.member) = from.*(p.member);
+  return e;
+}
+
 struct CandidateFit {
   int index = -1;  // into the candidate list
   FitResult fit;
   double val_cost = 0, improvement = 0, bic = 0;
   bool passes = false;
+  bool judged_early = false;  // passed on the earlier fold (the later block could not judge it)
 };
 
 struct GreedyResult {
@@ -39,9 +61,25 @@ struct GreedyResult {
 // simplest among those nearly as good) among those that lower it enough and the BIC too, with
 // identified parameters; a time-indexed change
 // gives way to a state-dependent candidate that explains most of the same.
-GreedyResult greedy(const FitProblem& fit, const FitProblem& val, const std::vector<const EffectSpec*>& cands,
+// The validation folds, forward in time: the main one (fit, then the later block), and an earlier
+// one (the fit part's first half, then its second half) that judges a candidate the later block
+// cannot judge: one that changes the later block's cost by less than opt.inconclusive_share (it
+// acts on a place, a regime or a stretch of time that the later block does not reach).
+struct Folds {
+  const FitProblem& fit;
+  const FitProblem& val;
+  const FitProblem& early_fit;
+  const FitProblem& early_val;
+};
+
+// The library effects a candidate stands for: itself, or for a joint candidate its two partners.
+using Members = std::vector<std::vector<int>>;
+
+GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& cands, const Members& members,
                     const std::vector<int>& pool, const SelectionOptions& opt, double n_eff,
                     std::vector<std::string>* log) {
+  const FitProblem& fit = folds.fit;
+  const FitProblem& val = folds.val;
   GreedyResult out;
   EffectParams base;
   double base_fit = mean_cost(fit, base), base_val = mean_cost(val, base);
@@ -59,19 +97,37 @@ GreedyResult greedy(const FitProblem& fit, const FitProblem& val, const std::vec
       c.bic = n_eff * std::log(c.fit.cost / base_fit) + k * std::log(n_eff);
       c.improvement = 1.0 - c.val_cost / base_val;
       c.passes = c.improvement >= opt.min_val_improvement && c.bic <= -opt.min_bic_drop && c.val_cost < base_val;
+      char earlier[96] = "";
+      if (!c.passes && c.bic <= -opt.min_bic_drop && c.improvement >= 0.0 && c.improvement < opt.inconclusive_share &&
+          !folds.early_val.segments.empty()) {
+        const FitResult early = fit_effect(folds.early_fit, base, *cands[static_cast<std::size_t>(i)]);
+        const double early_base = mean_cost(folds.early_val, base);
+        const double early_improvement = early_base > 0 ? 1.0 - mean_cost(folds.early_val, early.effects) / early_base : 0.0;
+        std::snprintf(earlier, sizeof earlier, " (later block inconclusive; earlier fold %+.1f %%)", 100 * early_improvement);
+        if (early_improvement >= opt.min_val_improvement) {
+          c.improvement = early_improvement;
+          c.passes = true;
+          c.judged_early = true;
+        }
+      }
       if (log) {
-        std::snprintf(line, sizeof line, "round %d: %-20s validation %+6.1f %%, dBIC %+9.1f%s", round,
-                      cands[static_cast<std::size_t>(i)]->id.c_str(), 100 * c.improvement, c.bic,
-                      c.passes ? "  passes" : "");
+        std::snprintf(line, sizeof line, "round %d: %-20s validation %+6.1f %%, dBIC %+9.1f%s%s", round,
+                      cands[static_cast<std::size_t>(i)]->id.c_str(), 100 * (1.0 - c.val_cost / base_val), c.bic,
+                      earlier, c.passes ? "  passes" : "");
         log->push_back(line);
       }
       if (c.passes && std::find(out.passed.begin(), out.passed.end(), i) == out.passed.end()) out.passed.push_back(i);
       tried.push_back(std::move(c));
     }
     if (round == 1) out.first_round = tried;
+    // Improvements on different blocks do not compare: what passed on the later block (the main
+    // fold) is ranked; what passed only on the earlier fold is considered when nothing else passes.
     std::vector<const CandidateFit*> order;
     for (const auto& c : tried)
-      if (c.passes) order.push_back(&c);
+      if (c.passes && !c.judged_early) order.push_back(&c);
+    if (order.empty())
+      for (const auto& c : tried)
+        if (c.passes) order.push_back(&c);
     // Ranked by how much they help on later data; among those within parsimony_share of the
     // best, the one with the fewest parameters the data use comes first (c v^2 over F0 + b v on a
     // speed range; F0 alone ties with c v^2 and the better one wins).
@@ -85,6 +141,13 @@ GreedyResult greedy(const FitProblem& fit, const FitProblem& val, const std::vec
         if (na != nb) return na;
         return na && params_of(a) < params_of(b);
       });
+      // Between near-best candidates of as many parameters, the validation difference is within
+      // its noise; strong evidence on the fit part (more data: a BIC lower by >= 6) decides.
+      const CandidateFit* front = order.front();
+      auto stronger = order.begin();
+      for (auto it = order.begin(); it != order.end(); ++it)
+        if ((*it)->improvement >= near_best && params_of(*it) == params_of(front) && (*it)->bic < (*stronger)->bic) stronger = it;
+      if ((*stronger)->bic <= front->bic - opt.strong_bic_evidence) std::rotate(order.begin(), stronger, stronger + 1);
     }
     const CandidateFit* pick = nullptr;
     for (const CandidateFit* c : order) {
@@ -119,8 +182,12 @@ GreedyResult greedy(const FitProblem& fit, const FitProblem& val, const std::vec
       if (log) log->push_back("round " + std::to_string(round) + ": no candidate passes; stop");
       break;
     }
-    taken[static_cast<std::size_t>(pick->index)] = true;
-    out.chosen.push_back(pick->index);
+    // A joint candidate is chosen as its partners; a chosen effect takes the joint candidates it is in.
+    const std::vector<int>& picked = members[static_cast<std::size_t>(pick->index)];
+    for (std::size_t j = 0; j < cands.size(); ++j)
+      for (int m : members[j])
+        if (std::find(picked.begin(), picked.end(), m) != picked.end()) taken[j] = true;
+    out.chosen.insert(out.chosen.end(), picked.begin(), picked.end());
     base = pick->fit.effects;
     base_fit = pick->fit.cost;
     base_val = pick->val_cost;
@@ -129,6 +196,52 @@ GreedyResult greedy(const FitProblem& fit, const FitProblem& val, const std::vec
                     cands[static_cast<std::size_t>(pick->index)]->id.c_str(), 100 * pick->improvement, pick->bic);
       log->push_back(line);
     }
+    // Each candidate was fitted with what came before held fixed; refit them together, so that the
+    // next round does not pick an effect only because it makes up for an earlier one's bias.
+    if (out.chosen.size() > 1) {
+      const FitResult joint = fit_params(fit, base, joint_free_params(cands, out.chosen));
+      if (joint.cost <= base_fit) {
+        base = joint.effects;
+        base_fit = joint.cost;
+        base_val = mean_cost(val, base);
+      }
+    }
+  }
+  // Backward elimination: an effect whose removal (the others refitted together) costs less than
+  // the improvement a new effect must bring on the validation data was made redundant by a later one.
+  while (out.chosen.size() > 1) {
+    int weakest = -1;
+    double weakest_share = opt.min_val_improvement;
+    EffectParams weakest_rest;
+    for (std::size_t k = 0; k < out.chosen.size(); ++k) {
+      std::vector<int> rest = out.chosen;
+      rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(k));
+      const FitResult refit = fit_params(fit, only_chosen(cands, rest, base), joint_free_params(cands, rest));
+      const double rest_val = mean_cost(val, refit.effects);
+      double share = rest_val > 0 ? 1.0 - base_val / rest_val : 0.0;  // what the effect adds on validation
+      if (share >= 0.0 && share < opt.inconclusive_share && !folds.early_val.segments.empty()) {
+        // The later block cannot judge it: the earlier fold does, both sets refitted on its fit part.
+        const FitResult all_early = fit_params(folds.early_fit, base, joint_free_params(cands, out.chosen));
+        const FitResult rest_early = fit_params(folds.early_fit, only_chosen(cands, rest, base), joint_free_params(cands, rest));
+        const double rest_cost = mean_cost(folds.early_val, rest_early.effects);
+        if (rest_cost > 0) share = 1.0 - mean_cost(folds.early_val, all_early.effects) / rest_cost;
+      }
+      if (share < weakest_share) {
+        weakest_share = share;
+        weakest = static_cast<int>(k);
+        weakest_rest = refit.effects;
+      }
+    }
+    if (weakest < 0) break;
+    if (log) {
+      std::snprintf(line, sizeof line, "backward: %s dropped (without it, the others refitted: validation cost %+.1f %%)",
+                    cands[static_cast<std::size_t>(out.chosen[static_cast<std::size_t>(weakest)])]->id.c_str(),
+                    100 * (1.0 / (1.0 - weakest_share) - 1.0));
+      log->push_back(line);
+    }
+    out.chosen.erase(out.chosen.begin() + weakest);
+    base = weakest_rest;
+    base_val = mean_cost(val, base);
   }
   out.effects = base;
   return out;
@@ -178,6 +291,11 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
       segs.size() - 3);
   fit.segments.assign(segs.begin(), segs.end() - static_cast<std::ptrdiff_t>(n_val));
   val.segments.assign(segs.end() - static_cast<std::ptrdiff_t>(n_val), segs.end());
+  FitProblem early_fit = fit, early_val = fit;
+  const std::size_t half = fit.segments.size() / 2;
+  early_fit.segments.assign(fit.segments.begin(), fit.segments.begin() + static_cast<std::ptrdiff_t>(half));
+  early_val.segments.assign(fit.segments.begin() + static_cast<std::ptrdiff_t>(half), fit.segments.end());
+  if (early_fit.segments.size() < 3 || early_val.segments.size() < 3) early_val.segments.clear();
   const double n_fit = static_cast<double>(fit.segments.size() * static_cast<std::size_t>(len) * kChannels);
   const double n_eff = n_fit / opt.samples_per_independent;
   char line[512];
@@ -197,11 +315,37 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
       cands.push_back(&effect_spec(id));
     }
   }
+  // Partner terms on one command are also fitted together, as one joint candidate: a steering
+  // map's gain and trim, a throttle map's gain and offset. Where both are wrong, each alone takes
+  // up part of the other's error and can fail where the two together explain the data.
+  Members members(cands.size());
+  for (std::size_t i = 0; i < cands.size(); ++i) members[i] = {static_cast<int>(i)};
+  std::deque<EffectSpec> joint_specs;
+  static const std::pair<const char*, const char*> kPartners[] = {{"steer_gain", "steer_offset"},
+                                                                   {"throttle_gain", "throttle_offset"}};
+  for (const auto& [a, b] : kPartners) {
+    int ia = -1, ib = -1;
+    for (std::size_t i = 0; i < cands.size(); ++i) {
+      if (cands[i]->id == a) ia = static_cast<int>(i);
+      if (cands[i]->id == b) ib = static_cast<int>(i);
+    }
+    if (ia < 0 || ib < 0) continue;
+    EffectSpec joint = *cands[static_cast<std::size_t>(ia)];
+    joint.id = std::string(a) + "+" + b;
+    joint.description = "joint: " + joint.description + "; " + cands[static_cast<std::size_t>(ib)]->description;
+    const auto& more = cands[static_cast<std::size_t>(ib)]->params;
+    joint.params.insert(joint.params.end(), more.begin(), more.end());
+    joint_specs.push_back(std::move(joint));
+    cands.push_back(&joint_specs.back());
+    members.push_back({ia, ib});
+  }
   const ExcitationLevels excitation = measure_excitation(d, train_mask);
   sel.candidates.resize(cands.size());
   std::vector<int> pool;
   for (std::size_t i = 0; i < cands.size(); ++i) {
     sel.candidates[i].id = cands[i]->id;
+    if (members[i].size() > 1)
+      for (int m : members[i]) sel.candidates[i].joint_of.push_back(cands[static_cast<std::size_t>(m)]->id);
     sel.candidates[i].not_testable = excitation_shortfall(cands[i]->needs, excitation);
     if (sel.candidates[i].not_testable.empty())
       pool.push_back(static_cast<int>(i));
@@ -211,7 +355,8 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
 
   const auto nominal_model = nominal.make({});
   const double held_nominal = heldout_1s_normalized_rmse(*nominal_model, d, heldout_mask, replay);
-  const GreedyResult main = greedy(fit, val, cands, pool, opt, n_eff, &sel.log);
+  const Folds folds{fit, val, early_fit, early_val};
+  const GreedyResult main = greedy(folds, cands, members, pool, opt, n_eff, &sel.log);
   for (const CandidateFit& c : main.first_round) {
     CandidateReport& r = sel.candidates[static_cast<std::size_t>(c.index)];
     r.params = c.fit.params;
@@ -251,10 +396,16 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
     for (int b = 0; b < opt.stability_resamples; ++b) {
       FitProblem fit_b = fit;
       fit_b.segments = resample_blocks(fit.segments, block, rng);
-      const GreedyResult g = greedy(fit_b, val, cands, stable_pool, opt, n_eff, nullptr);
+      const GreedyResult g = greedy({fit_b, val, early_fit, early_val}, cands, members, stable_pool, opt, n_eff, nullptr);
       for (int i : g.chosen) ++inclusion[static_cast<std::size_t>(i)];
     }
-    for (int i : stable_pool) {
+    std::vector<int> reported;  // the library effects that the pool and the main selection stand for
+    for (int i : stable_pool)
+      for (int m : members[static_cast<std::size_t>(i)])
+        if (std::find(reported.begin(), reported.end(), m) == reported.end()) reported.push_back(m);
+    for (int i : main.chosen)
+      if (std::find(reported.begin(), reported.end(), i) == reported.end()) reported.push_back(i);
+    for (int i : reported) {
       CandidateReport& r = sel.candidates[static_cast<std::size_t>(i)];
       r.inclusion_frequency = static_cast<double>(inclusion[static_cast<std::size_t>(i)]) / opt.stability_resamples;
       std::snprintf(line, sizeof line, "stability: %s chosen in %d of %d resamples", r.id.c_str(),
@@ -273,6 +424,18 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
     }
     named.push_back(r.id);
   }
+  // Stability selection names what the resamples choose: an effect chosen in enough of them is
+  // named even where the selection on all the data took a near rival in its place.
+  if (opt.stability_resamples > 0 && !main.chosen.empty())
+    for (std::size_t i = 0; i < cands.size(); ++i) {
+      const CandidateReport& r = sel.candidates[i];
+      if (!r.joint_of.empty() || r.inclusion_frequency < opt.min_inclusion_frequency) continue;
+      if (std::find(named.begin(), named.end(), r.id) != named.end()) continue;
+      std::snprintf(line, sizeof line, "stable: %s chosen in %.0f %% of the resamples, named though not chosen on all the data",
+                    r.id.c_str(), 100 * r.inclusion_frequency);
+      sel.log.push_back(line);
+      named.push_back(r.id);
+    }
 
   // Joint refit of the named effects on all training segments; an effect whose parameter ends at
   // a bound there is not identified either.

@@ -73,10 +73,14 @@ const std::vector<SweepCase>& sweep_cases() {
 
 namespace {
 
+// The truth's pure command delays are the plant's actuators' (exact), not the model's.
 template <VehicleDynamics M>
-sim::Recording drive_open_loop(M truth_model, std::uint64_t seed, double duration_s, const SensorNoise& noise) {
+sim::Recording drive_open_loop(M truth_model, const EffectParams& truth, std::uint64_t seed, double duration_s,
+                               const SensorNoise& noise) {
   sim::ActuatorLimits fast;
   fast.steer_rate_per_s = fast.throttle_rate_per_s = 1e4f;
+  fast.steer_delay_s = static_cast<float>(truth.steer_delay_s);
+  fast.throttle_delay_s = static_cast<float>(truth.throttle_delay_s);
   sim::Plant<M> plant(std::move(truth_model), fast, 0.002f);
   VehicleState s0;
   s0.vx_mps = 4.f;
@@ -129,8 +133,10 @@ sim::Recording synthesize_open_loop(const EffectParams& truth, std::uint64_t see
   const CorrectedModelFile defaults;  // the library's default parameters of every nominal model
   visit_by_name(CorrectedNominalModels{}, nominal_model, [&]<class D>() {
     using M = WithEffects<typename D::Model>;
-    rec.emplace(drive_open_loop(M(corrected_nominal<D>(defaults, sim::network_file_or_default("")), truth), seed,
-                                duration_s, noise));
+    EffectParams undelayed = truth;
+    undelayed.steer_delay_s = undelayed.throttle_delay_s = 0.0;
+    rec.emplace(drive_open_loop(M(corrected_nominal<D>(defaults, sim::network_file_or_default("")), undelayed), truth,
+                                seed, duration_s, noise));
   });
   if (!rec) throw Error("synthesize_open_loop: unknown nominal model '" + nominal_model + "' (valid: " +
                         kCorrectedNominalModels + ")");

@@ -99,7 +99,11 @@ TEST_CASE("two hidden effects at once are both named; report and model file agre
   for (const char* key : {"selected", "effects", "mismatch", "fit_before", "fit_after", "heldout_rmse_before",
                           "heldout_rmse_after", "model_file"})
     CHECK(j.contains(key));
-  CHECK(j["effects"].size() == effect_library().size());
+  // One row per library effect, and the joint candidates (partner terms fitted together) apart.
+  std::size_t library_rows = 0, joint_rows = 0;
+  for (const auto& e : j["effects"]) (e.contains("joint_of") ? joint_rows : library_rows)++;
+  CHECK(library_rows == effect_library().size());
+  CHECK(joint_rows == 2);
   CHECK(!j["mismatch"].empty());
   const CorrectedModelFile f = load_corrected_model(j["model_file"].get<std::string>());
   CHECK(f.effects.steer_delay_s == Approx(0.08).margin(0.01));
@@ -173,7 +177,7 @@ TEST_CASE("a straight-line recording cannot name steering or grip effects", "[di
   CHECK(r.selection.selected.empty());
   for (const auto& c : r.selection.candidates) {
     INFO(c.id);
-    const Excitation needs = effect_spec(c.id).needs;
+    const Excitation needs = effect_spec(c.joint_of.empty() ? c.id : c.joint_of[0]).needs;
     if (needs == Excitation::kSteer || needs == Excitation::kCornering) CHECK_FALSE(c.not_testable.empty());
     if (needs == Excitation::kThrottle) CHECK(c.not_testable.empty());
   }
