@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <deque>
 #include <limits>
+#include <optional>
 #include <random>
 
 #include "mppi/error.hpp"
@@ -32,12 +33,18 @@ std::vector<ParamSpec> joint_free_params(const std::vector<const EffectSpec*>& c
   return free;
 }
 
-// The effect parameters of the chosen candidates only (the others at their defaults).
-EffectParams only_chosen(const std::vector<const EffectSpec*>& cands, const std::vector<int>& chosen, const EffectParams& from) {
+// Effect parameters of `ids` copied from `from`, everything else at its default.
+EffectParams only(const std::vector<std::string>& ids, const EffectParams& from) {
   EffectParams e;
-  for (int i : chosen)
-    for (const EffectParamSpec& p : cands[static_cast<std::size_t>(i)]->params) e.*(p.member) = from.*(p.member);
+  for (const auto& id : ids)
+    for (const EffectParamSpec& p : effect_spec(id).params) e.*(p.member) = from.*(p.member);
   return e;
+}
+
+std::vector<std::string> ids_of(const std::vector<const EffectSpec*>& cands, const std::vector<int>& chosen) {
+  std::vector<std::string> ids;
+  for (int i : chosen) ids.push_back(cands[static_cast<std::size_t>(i)]->id);
+  return ids;
 }
 
 struct CandidateFit {
@@ -213,18 +220,19 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
     int weakest = -1;
     double weakest_share = opt.min_val_improvement;
     EffectParams weakest_rest;
+    std::optional<FitResult> all_early;  // all the chosen effects on the earlier fold, when needed
     for (std::size_t k = 0; k < out.chosen.size(); ++k) {
       std::vector<int> rest = out.chosen;
       rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(k));
-      const FitResult refit = fit_params(fit, only_chosen(cands, rest, base), joint_free_params(cands, rest));
+      const FitResult refit = fit_params(fit, only(ids_of(cands, rest), base), joint_free_params(cands, rest));
       const double rest_val = mean_cost(val, refit.effects);
       double share = rest_val > 0 ? 1.0 - base_val / rest_val : 0.0;  // what the effect adds on validation
       if (share >= 0.0 && share < opt.inconclusive_share && !folds.early_val.segments.empty()) {
         // The later block cannot judge it: the earlier fold does, both sets refitted on its fit part.
-        const FitResult all_early = fit_params(folds.early_fit, base, joint_free_params(cands, out.chosen));
-        const FitResult rest_early = fit_params(folds.early_fit, only_chosen(cands, rest, base), joint_free_params(cands, rest));
+        if (!all_early) all_early = fit_params(folds.early_fit, base, joint_free_params(cands, out.chosen));
+        const FitResult rest_early = fit_params(folds.early_fit, only(ids_of(cands, rest), base), joint_free_params(cands, rest));
         const double rest_cost = mean_cost(folds.early_val, rest_early.effects);
-        if (rest_cost > 0) share = 1.0 - mean_cost(folds.early_val, all_early.effects) / rest_cost;
+        if (rest_cost > 0) share = 1.0 - mean_cost(folds.early_val, all_early->effects) / rest_cost;
       }
       if (share < weakest_share) {
         weakest_share = share;
@@ -260,13 +268,6 @@ std::vector<Segment> resample_blocks(const std::vector<Segment>& segs, int block
   return out;
 }
 
-// Effect parameters of `ids` copied from `from`, everything else at its default.
-EffectParams only(const std::vector<std::string>& ids, const EffectParams& from) {
-  EffectParams e;
-  for (const auto& id : ids)
-    for (const EffectParamSpec& p : effect_spec(id).params) e.*(p.member) = from.*(p.member);
-  return e;
-}
 
 }  // namespace
 
