@@ -23,8 +23,10 @@
 //             steer_backlash              play of width b between servo and wheels
 //   chassis:  tire_saturation             Magic Formula peak D -> k D, B -> s B / k
 //             friction_change             grip (D, Sv) x g from time t_change on
-//             grip_patch                  grip x g on a disc of the ground (centre, radius; a
-//                                         smooth edge a quarter of a metre wide)
+//             grip_patch                  grip x g on one to three discs of the ground (centre,
+//                                         radius each; one surface, so one g; a smooth edge a
+//                                         quarter of a metre wide). The second and third discs
+//                                         are optional: radius 0 = no disc
 //             load_transfer               CG height h -> h + dh (pitch load transfer)
 //             payload                     mass x m, yaw inertia x j
 //             motor_speed                 no-load speed x v (the motor's torque-speed line)
@@ -95,6 +97,12 @@ struct EffectParams {
   double patch_y_m = 0.0;            // [m]
   double patch_radius_m = 0.0;       // [m] radius of the grip patch
   double patch_grip_scale = 1.0;     // [-] grip factor on the patch (1 = no patch)
+  double patch2_x_m = 0.0;           // [m] centre of a second disc of the same surface
+  double patch2_y_m = 0.0;           // [m]
+  double patch2_radius_m = 0.0;      // [m] its radius (0 = no second disc)
+  double patch3_x_m = 0.0;           // [m] centre of a third disc of the same surface
+  double patch3_y_m = 0.0;           // [m]
+  double patch3_radius_m = 0.0;      // [m] its radius (0 = no third disc)
 
   bool is_valid(std::string* why) const;
 };
@@ -183,11 +191,18 @@ inline const std::vector<EffectSpec>& effect_table() {
       {"friction_change", "grip (whole friction curve) x g from time t_change on", H::kChassis,
        {{"grip_change_time_s", &E::grip_change_time_s, "s", kAny, 0.0, 1e9, 1.0},
         {"grip_scale", &E::grip_scale, "1", kScale, 0.3, 3.0, 0.1}}, {}, DataGrid::kTime, X::kCornering},
-      {"grip_patch", "grip (whole friction curve) x g on a disc of the ground: a patch of other surface", H::kChassis,
+      {"grip_patch", "grip (whole friction curve) x g on one to three discs of the ground: patches of other surface", H::kChassis,
        {{"patch_x_m", &E::patch_x_m, "m", kAny, -1e9, 1e9, 1.0},
         {"patch_y_m", &E::patch_y_m, "m", kAny, -1e9, 1e9, 1.0},
         {"patch_radius_m", &E::patch_radius_m, "m", kNonNeg, 0.0, 30.0, 0.5},
-        {"patch_grip_scale", &E::patch_grip_scale, "1", kScale, 0.3, 3.0, 0.1}}, {}, DataGrid::kPlace, X::kCornering},
+        {"patch_grip_scale", &E::patch_grip_scale, "1", kScale, 0.3, 3.0, 0.1},
+        {"patch2_x_m", &E::patch2_x_m, "m", kAny, -1e9, 1e9, 1.0},
+        {"patch2_y_m", &E::patch2_y_m, "m", kAny, -1e9, 1e9, 1.0},
+        {"patch2_radius_m", &E::patch2_radius_m, "m", kNonNeg, 0.0, 30.0, 0.5},
+        {"patch3_x_m", &E::patch3_x_m, "m", kAny, -1e9, 1e9, 1.0},
+        {"patch3_y_m", &E::patch3_y_m, "m", kAny, -1e9, 1e9, 1.0},
+        {"patch3_radius_m", &E::patch3_radius_m, "m", kNonNeg, 0.0, 30.0, 0.5}},
+       {}, DataGrid::kPlace, X::kCornering},
       {"load_transfer", "pitch load transfer: CG height h + dh", H::kChassis,
        {{"cg_height_delta_m", &E::cg_height_delta_m, "m", kAny, -0.115, 0.12, 0.02}}, {}, DataGrid::kNone, X::kBraking},
       {"motor_voltage_sag", "drive falls with current: throttle u - k max(u,0)^2", H::kActuator,
@@ -237,6 +252,29 @@ inline const EffectSpec& effect_spec(const std::string& id) {
     ids += (ids.empty() ? "" : ", ") + e.id;
   }
   throw Error("unknown effect '" + id + "' (valid: " + ids + ")");
+}
+
+// The grip patch's optional discs (the second and third: centre x, y and radius each; radius 0 =
+// no disc). Their parameters take part in a fit only while the disc is there.
+struct OptionalDisc {
+  double EffectParams::*x;
+  double EffectParams::*y;
+  double EffectParams::*radius;
+};
+inline constexpr OptionalDisc kOptionalPatchDiscs[] = {
+    {&EffectParams::patch2_x_m, &EffectParams::patch2_y_m, &EffectParams::patch2_radius_m},
+    {&EffectParams::patch3_x_m, &EffectParams::patch3_y_m, &EffectParams::patch3_radius_m},
+};
+inline bool is_optional_disc_param(const EffectParamSpec& p) {
+  for (const OptionalDisc& d : kOptionalPatchDiscs)
+    if (p.member == d.x || p.member == d.y || p.member == d.radius) return true;
+  return false;
+}
+// False for a parameter of an optional disc that `e` does not have; true for every other one.
+inline bool effect_param_active(const EffectParamSpec& p, const EffectParams& e) {
+  for (const OptionalDisc& d : kOptionalPatchDiscs)
+    if (p.member == d.x || p.member == d.y || p.member == d.radius) return e.*(d.radius) > 0.0;
+  return true;
 }
 
 // The effect parameters as a parameter table (keys as in the corrected-model file).

@@ -10,8 +10,8 @@
 //     sag transform the command first;
 //   - chassis: tire_saturation, friction_change, grip_patch, load_transfer, payload and
 //     motor_speed change the base's single-track core parameters (apply_effect_params), with a
-//     second base model for the other grip: after a change (time is a state) or on the patch
-//     (across the patch's edge the two steps are blended). Only for bases with such a core (the
+//     second base model for the other grip: after a change (time is a state) or on the patch's
+//     discs (across a disc's edge the two steps are blended). Only for bases with such a core (the
 //     single-track and four-wheel models); the kinematic bicycle and the network have none, so
 //     these are refused;
 //   - force: aero_drag, rolling_resistance and road_grade add an acceleration along the body
@@ -25,6 +25,7 @@
 // backlash, whose output is applied).
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -96,9 +97,14 @@ class WithEffects {
     change_time_ = static_cast<float>(effects_.grip_change_time_s);
     grip_changes_ = effects_.grip_scale != 1.0;
     patch_ = effects_.patch_grip_scale != 1.0;
-    patch_x_ = static_cast<float>(effects_.patch_x_m);
-    patch_y_ = static_cast<float>(effects_.patch_y_m);
-    patch_r_ = static_cast<float>(effects_.patch_radius_m);
+    if (patch_) {
+      discs_[discs_n_++] = {static_cast<float>(effects_.patch_x_m), static_cast<float>(effects_.patch_y_m),
+                            static_cast<float>(effects_.patch_radius_m)};
+      for (const OptionalDisc& d : kOptionalPatchDiscs)
+        if (effects_.*(d.radius) > 0.0)
+          discs_[discs_n_++] = {static_cast<float>(effects_.*(d.x)), static_cast<float>(effects_.*(d.y)),
+                                static_cast<float>(effects_.*(d.radius))};
+    }
     gain_ = static_cast<float>(effects_.steer_gain);
     offset_ = static_cast<float>(effects_.steer_offset);
     steer_cubic_ = static_cast<float>(effects_.steer_cubic);
@@ -217,15 +223,19 @@ class WithEffects {
   }
 
  private:
-  // Weight of the other grip at this time and place: 0 or 1 for a change in time; on a patch a
-  // logistic edge kPatchEdge_m wide, snapped to 0 / 1 where it is within 1e-3 of them (so the
-  // car steps one base model away from the edge).
+  // Weight of the other grip at this time and place: 0 or 1 for a change in time; on the patch's
+  // discs a logistic edge kPatchEdge_m wide, snapped to 0 / 1 where it is within 1e-3 of them (so
+  // the car steps one base model away from the edge). Where discs overlap, the nearest edge
+  // inward counts (the largest weight).
   static constexpr float kPatchEdge_m = 0.25f;
   float other_grip_weight(float t_s, float x_m, float y_m) const noexcept {
     if (grip_changes_) return t_s < change_time_ ? 0.f : 1.f;
     if (!patch_) return 1.f;  // only the nominal grip: after_ == before_
-    const float dx = x_m - patch_x_, dy = y_m - patch_y_;
-    const float z = (std::sqrt(dx * dx + dy * dy) - patch_r_) / kPatchEdge_m;
+    float z = 7.f;            // edge distance in edge widths, negative inside
+    for (int i = 0; i < discs_n_; ++i) {
+      const float dx = x_m - discs_[i].x_m, dy = y_m - discs_[i].y_m;
+      z = std::min(z, (std::sqrt(dx * dx + dy * dy) - discs_[i].radius_m) / kPatchEdge_m);
+    }
     if (z > 6.9f) return 0.f;
     if (z < -6.9f) return 1.f;
     return 1.f / (1.f + std::exp(z));
@@ -281,7 +291,11 @@ class WithEffects {
   Base before_, after_;
   float drag_per_kg_ = 0, roll_per_kg_ = 0, visc_per_kg_ = 0, freewheel_per_kg_ = 0, grade_x_ = 0, grade_y_ = 0, change_time_ = 0;
   bool grip_changes_ = false, patch_ = false;
-  float patch_x_ = 0, patch_y_ = 0, patch_r_ = 0;
+  struct Disc {
+    float x_m, y_m, radius_m;
+  };
+  Disc discs_[1 + std::size(kOptionalPatchDiscs)] = {};  // the patch's discs (grip patch_grip_scale)
+  int discs_n_ = 0;
   float gain_ = 1, offset_ = 0, steer_cubic_ = 0, left_gain_ = 1, right_gain_ = 1;  // steering map
   float throttle_gain_ = 1, thr_offset_ = 0, sag_ = 0;                              // throttle map
 };

@@ -15,7 +15,10 @@ std::size_t used_param_count(const EffectSpec& spec, const FitResult& fit) {
   const EffectParams defaults;
   std::size_t used = 0;
   for (std::size_t j = 0; j < spec.params.size(); ++j) {
-    if (static_cast<int>(j) < grid_param_count(spec.data_grid) || j >= fit.params.size()) {
+    if (!effect_param_active(spec.params[j], fit.effects)) continue;  // a disc the fit did not add
+    // a place searched over the data, or a further disc the fit added (it lowered the cost clearly)
+    if (static_cast<int>(j) < grid_param_count(spec.data_grid) || is_optional_disc_param(spec.params[j]) ||
+        j >= fit.params.size()) {
       ++used;
       continue;
     }
@@ -75,23 +78,59 @@ std::vector<std::pair<double, double>> spread_places(const FitProblem& p, int co
 
 }  // namespace
 
-// A place-dependent effect (params: x, y, then the rest): its leading parameters are searched
-// over places the car visited with a few sizes and strengths of the rest, then the best starts
-// are refined by least squares in all parameters (the effect's edge is smooth).
+namespace {
+
+// The estimates in the order of spec.params: the fitted ones from `fit`, every other parameter at
+// its value in fit.effects with no spread (an optional disc that is not there).
+std::vector<ParamEstimate> in_spec_order(const EffectSpec& spec, const FitResult& fit) {
+  std::vector<ParamEstimate> out;
+  for (const EffectParamSpec& q : spec.params) {
+    const auto it = std::find_if(fit.params.begin(), fit.params.end(),
+                                 [&](const ParamEstimate& e) { return e.name == q.name; });
+    out.push_back(it != fit.params.end() ? *it : ParamEstimate{q.name, q.unit, fit.effects.*(q.member), 0.0});
+  }
+  return out;
+}
+
+// A further disc of the patch's surface is kept only when it lowers the fit cost by this share:
+// the level at which a whole effect counts as seen on validation (SelectionOptions::
+// min_val_improvement), so that a disc is not fitted to noise.
+constexpr double kFurtherDiscGain = 0.03;
+
+}  // namespace
+
+std::vector<ParamSpec> active_params(const EffectSpec& spec, const EffectParams& e) {
+  std::vector<ParamSpec> out;
+  for (const EffectParamSpec& q : spec.params)
+    if (effect_param_active(q, e)) out.push_back(q);
+  return out;
+}
+
+// A place-dependent effect (params: x, y, then the rest of its first disc, then optional further
+// discs): the first disc's place is searched over places the car visited with a few sizes and
+// strengths of the rest, then the best starts are refined by least squares in all its parameters
+// (the edge is smooth). A further disc (grip_patch: up to three of one surface) is searched the
+// same way with the discs found so far in place and kept when it lowers the cost clearly; each
+// kept disc is refitted together with the others.
 FitResult fit_place_effect(const FitProblem& p, const EffectParams& base, const EffectSpec& spec) {
   constexpr int kPlaces = 16, kStarts = 2;
-  const EffectParamSpec& px = spec.params[0];
-  const EffectParamSpec& py = spec.params[1];
+  constexpr std::size_t kFirstDisc = 4;  // x, y, radius, strength
+  const std::vector<ParamSpec> first(spec.params.begin(),
+                                     spec.params.begin() + static_cast<std::ptrdiff_t>(std::min(kFirstDisc, spec.params.size())));
+  const EffectParamSpec& px = first[0];
+  const EffectParamSpec& py = first[1];
+  const auto places = spread_places(p, kPlaces);
   struct Start {
     double cost;
     EffectParams e;
   };
+  auto by_cost = [](const Start& a, const Start& b) { return a.cost < b.cost; };
   std::vector<Start> starts;
-  for (const auto& [x, y] : spread_places(p, kPlaces)) {
+  for (const auto& [x, y] : places) {
     // The other parameters at a small and a large value on each side of their default.
     std::vector<EffectParams> variants(1, base);
-    for (std::size_t i = 2; i < spec.params.size(); ++i) {
-      const EffectParamSpec& q = spec.params[i];
+    for (std::size_t i = 2; i < first.size(); ++i) {
+      const EffectParamSpec& q = first[i];
       const double d = base.*(q.member);
       std::vector<EffectParams> next;
       for (const EffectParams& v : variants)
@@ -110,17 +149,42 @@ FitResult fit_place_effect(const FitProblem& p, const EffectParams& base, const 
       starts.push_back({mean_cost(p, e), e});
     }
   }
-  std::sort(starts.begin(), starts.end(), [](const Start& a, const Start& b) { return a.cost < b.cost; });
+  std::sort(starts.begin(), starts.end(), by_cost);
   FitResult best;
   best.cost = std::numeric_limits<double>::infinity();
   best.effects = base;
   for (std::size_t s = 0; s < starts.size() && s < kStarts; ++s) {
     if (!std::isfinite(starts[s].cost)) break;
-    FitResult r = fit_params(p, starts[s].e, spec.params, 10);
+    FitResult r = fit_params(p, starts[s].e, first, 10);
     if (r.cost < best.cost) best = r;
   }
-  if (best.params.empty())
-    for (const EffectParamSpec& q : spec.params) best.params.push_back({q.name, q.unit, base.*(q.member), 0.0});
+  for (const OptionalDisc& disc : kOptionalPatchDiscs) {
+    const bool of_this_effect = std::any_of(spec.params.begin(), spec.params.end(),
+                                            [&](const EffectParamSpec& q) { return q.member == disc.radius; });
+    if (!of_this_effect || !std::isfinite(best.cost)) break;
+    const EffectParamSpec& radius = *std::find_if(spec.params.begin(), spec.params.end(),
+                                                  [&](const EffectParamSpec& q) { return q.member == disc.radius; });
+    starts.clear();
+    for (const auto& [x, y] : places)
+      for (double f : {0.25, 0.6}) {
+        EffectParams e = best.effects;
+        e.*(disc.x) = x;
+        e.*(disc.y) = y;
+        e.*(disc.radius) = radius.lo + f * 0.4 * (radius.hi - radius.lo);
+        starts.push_back({mean_cost(p, e), e});
+      }
+    std::sort(starts.begin(), starts.end(), by_cost);
+    FitResult more;
+    more.cost = std::numeric_limits<double>::infinity();
+    for (std::size_t s = 0; s < starts.size() && s < kStarts; ++s) {
+      if (!std::isfinite(starts[s].cost) || starts[s].cost >= best.cost) break;
+      FitResult r = fit_params(p, starts[s].e, active_params(spec, starts[s].e), 8);
+      if (r.cost < more.cost) more = r;
+    }
+    if (!(more.cost < (1.0 - kFurtherDiscGain) * best.cost) || !(more.effects.*(disc.radius) > 0.0)) break;
+    best = more;
+  }
+  best.params = in_spec_order(spec, best);
   return best;
 }
 

@@ -52,7 +52,11 @@ std::size_t used_param_count(const EffectSpec& spec, const FitResult& fit);
 FitResult fit_params(const FitProblem& p, const EffectParams& base, const std::vector<ParamSpec>& free,
                      int max_iterations = 15);
 
-// A place-dependent effect (grip_patch): its place searched over where the car went, then LM.
+// The parameters of `spec` that a fit moves at `e`: all but the optional discs `e` does not have.
+std::vector<ParamSpec> active_params(const EffectSpec& spec, const EffectParams& e);
+
+// A place-dependent effect (grip_patch): its place searched over where the car went, then LM;
+// further discs of the same surface added while each lowers the cost clearly.
 FitResult fit_place_effect(const FitProblem& p, const EffectParams& base, const EffectSpec& spec);
 
 // One effect (spec) on top of base: start-value grid search, then LM.

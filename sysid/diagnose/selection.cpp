@@ -21,14 +21,15 @@ double heldout_1s_normalized_rmse(const ReplayModel& m, const DiagData& d, const
   return horizon_metrics(m, d, mask, {1.0}, 5, o)[0].normalized_rmse;
 }
 
-// The parameters of these candidates that a joint least-squares refit moves: all but a change
-// time, which was searched over the data.
-std::vector<ParamSpec> joint_free_params(const std::vector<const EffectSpec*>& cands, const std::vector<int>& chosen) {
+// The parameters of these candidates that a joint least-squares refit moves at `at`: all but a
+// change time, which was searched over the data, and an optional disc that is not there.
+std::vector<ParamSpec> joint_free_params(const std::vector<const EffectSpec*>& cands, const std::vector<int>& chosen,
+                                         const EffectParams& at) {
   std::vector<ParamSpec> free;
   for (int i : chosen) {
     const EffectSpec& s = *cands[static_cast<std::size_t>(i)];
     for (std::size_t j = 0; j < s.params.size(); ++j)
-      if (!(s.data_grid == DataGrid::kTime && j == 0)) free.push_back(s.params[j]);
+      if (!(s.data_grid == DataGrid::kTime && j == 0) && effect_param_active(s.params[j], at)) free.push_back(s.params[j]);
   }
   return free;
 }
@@ -206,7 +207,7 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
     // Each candidate was fitted with what came before held fixed; refit them together, so that the
     // next round does not pick an effect only because it makes up for an earlier one's bias.
     if (out.chosen.size() > 1) {
-      const FitResult joint = fit_params(fit, base, joint_free_params(cands, out.chosen));
+      const FitResult joint = fit_params(fit, base, joint_free_params(cands, out.chosen, base));
       if (joint.cost <= base_fit) {
         base = joint.effects;
         base_fit = joint.cost;
@@ -224,13 +225,14 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
     for (std::size_t k = 0; k < out.chosen.size(); ++k) {
       std::vector<int> rest = out.chosen;
       rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(k));
-      const FitResult refit = fit_params(fit, only(ids_of(cands, rest), base), joint_free_params(cands, rest));
+      const EffectParams rest_start = only(ids_of(cands, rest), base);
+      const FitResult refit = fit_params(fit, rest_start, joint_free_params(cands, rest, rest_start));
       const double rest_val = mean_cost(val, refit.effects);
       double share = rest_val > 0 ? 1.0 - base_val / rest_val : 0.0;  // what the effect adds on validation
       if (share >= 0.0 && share < opt.inconclusive_share && !folds.early_val.segments.empty()) {
         // The later block cannot judge it: the earlier fold does, both sets refitted on its fit part.
-        if (!all_early) all_early = fit_params(folds.early_fit, base, joint_free_params(cands, out.chosen));
-        const FitResult rest_early = fit_params(folds.early_fit, only(ids_of(cands, rest), base), joint_free_params(cands, rest));
+        if (!all_early) all_early = fit_params(folds.early_fit, base, joint_free_params(cands, out.chosen, base));
+        const FitResult rest_early = fit_params(folds.early_fit, rest_start, joint_free_params(cands, rest, rest_start));
         const double rest_cost = mean_cost(folds.early_val, rest_early.effects);
         if (rest_cost > 0) share = 1.0 - mean_cost(folds.early_val, all_early->effects) / rest_cost;
       }
@@ -453,7 +455,7 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
             if (c.id == id && !c.params.empty()) fixed_times.back().stddev = c.params[0].stddev;
           continue;
         }
-        free.push_back(s.params[j]);
+        if (effect_param_active(s.params[j], start)) free.push_back(s.params[j]);
       }
     }
     const FitResult joint = fit_params(all, start, free);

@@ -262,6 +262,19 @@ TEST_CASE("a grip patch is the base model with the friction curve scaled on the 
   around.patch_radius_m = 50;
   CHECK(max_difference_after(SingleTrack(slippery), CorrectedSingleTrack(SingleTrack(), around), u, u, 500) < 1e-5f);
   CHECK(max_difference_after(SingleTrack(), CorrectedSingleTrack(SingleTrack(), around), u, u, 500) > 1e-2f);
+  // A second or third disc of the same surface acts like the first: the car inside any one of
+  // them has the slippery curve, whatever the others are; radius 0 is no disc.
+  EffectParams second = far_away;
+  second.patch2_radius_m = 50;
+  CHECK(max_difference_after(SingleTrack(slippery), CorrectedSingleTrack(SingleTrack(), second), u, u, 500) < 1e-5f);
+  EffectParams third = far_away;
+  third.patch2_x_m = -100;
+  third.patch2_radius_m = 3;
+  third.patch3_radius_m = 50;
+  CHECK(max_difference_after(SingleTrack(slippery), CorrectedSingleTrack(SingleTrack(), third), u, u, 500) < 1e-5f);
+  EffectParams none_there = third;
+  none_there.patch3_radius_m = 0;
+  CHECK(max_difference_after(SingleTrack(), CorrectedSingleTrack(SingleTrack(), none_there), u, u, 500) == 0.f);
 
   // On the patch's edge (distance = radius) the step is the mean of the two grips' steps.
   EffectParams edge = far_away;

@@ -233,10 +233,11 @@ namespace {
 
 // Circles of radius 8 m around the origin, written here independently of the library's effects:
 // two single-track cars, the nominal one and one whose friction curve is halved, and the plant
-// steps the slippery one while the car is on a disc of radius 3 m centred at (8, 0) (a hard
-// edge, where the library's patch has a smooth one). Steering follows the circle with a dither,
-// the speed steps between 4 and 6 m/s; 50 Hz, a little sensor noise.
-sim::Recording circles_over_a_patch(std::uint64_t seed, double duration_s) {
+// steps the slippery one while the car is on a disc of radius 3 m centred at one of
+// `patch_centres_m` (a hard edge, where the library's patch has a smooth one). Steering follows
+// the circle with a dither, the speed steps between 4 and 6 m/s; 50 Hz, a little sensor noise.
+sim::Recording circles_over_patches(std::uint64_t seed, double duration_s,
+                                    const std::vector<std::pair<double, double>>& patch_centres_m) {
   SingleTrackParams slippery_params;
   slippery_params.tyre.D *= 0.5;
   slippery_params.tyre.Sv *= 0.5;
@@ -267,7 +268,9 @@ sim::Recording circles_over_a_patch(std::uint64_t seed, double duration_s) {
     for (std::size_t c = 0; c < rec.columns.size(); ++c) rec.data[c].push_back(row[c]);
     const float u[2] = {steer, throttle};
     for (int j = 0; j < 10; ++j) {
-      const bool on_patch = std::hypot(x[state::kX] - 8.0, x[state::kY]) < 3.0;
+      const bool on_patch = std::any_of(patch_centres_m.begin(), patch_centres_m.end(), [&](const auto& c) {
+        return std::hypot(x[state::kX] - c.first, x[state::kY] - c.second) < 3.0;
+      });
       (on_patch ? slippery : nominal).step<1>(Batch<SingleTrack::kNx, 1>{x}, ConstBatch<2, 1>{u}, 0.002f, nullptr);
     }
   }
@@ -277,7 +280,7 @@ sim::Recording circles_over_a_patch(std::uint64_t seed, double duration_s) {
 }  // namespace
 
 TEST_CASE("a patch of low grip is named as a place, not as a change in time", "[diagnose][slow]") {
-  const DiagData d = prepare(circles_over_a_patch(11, 60.0), "circles over a patch");
+  const DiagData d = prepare(circles_over_patches(11, 60.0, {{8.0, 0.0}}), "circles over a patch");
   DiagnoseOptions o;
   o.plots = false;
   const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track"), o);
@@ -292,6 +295,7 @@ TEST_CASE("a patch of low grip is named as a place, not as a change in time", "[
   CHECK(std::hypot(e.patch_x_m - 8.0, e.patch_y_m) < 1.5);
   CHECK(e.patch_radius_m == Approx(3.0).margin(1.0));
   CHECK(e.patch_grip_scale == Approx(0.5).margin(0.15));
+  CHECK(e.patch2_radius_m == 0.0);  // one patch: no further disc
   CHECK(r.heldout_rmse_reduction > 0.3);
   // Located as a place before the correction; after it, no place stands out on the held-out part.
   auto at_a_place = [](const std::vector<Mismatch>& ms) {
@@ -324,4 +328,34 @@ TEST_CASE("simplicity counts only the parameters a fit moved off their default",
   const mppi::EffectParams defaults;
   for (const auto& p : patch.params) at_default.emplace_back(defaults.*(p.member), 1.0);
   CHECK(mppi::diagnose::used_param_count(patch, fit_of(at_default)) == 2);
+  // A second disc the fit added counts with its place and radius; a third it did not add, not at all.
+  FitResult two_discs = fit_of(at_default);
+  two_discs.effects.patch2_radius_m = 2.0;
+  CHECK(mppi::diagnose::used_param_count(patch, two_discs) == 5);
+}
+
+TEST_CASE("two patches of one low-grip surface are named as one grip patch with two discs", "[diagnose][slow]") {
+  // The same circles with slippery discs on opposite sides of the circle.
+  const DiagData d = prepare(circles_over_patches(12, 40.0, {{8.0, 0.0}, {-8.0, 0.0}}), "circles over two patches");
+  DiagnoseOptions o;
+  o.plots = false;
+  const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track"), o);
+  std::string named;
+  for (const auto& s : r.selection.selected) named += s + " ";
+  const EffectParams& e = r.selection.final_effects;
+  INFO("named: " << named << "; discs (" << e.patch_x_m << ", " << e.patch_y_m << ", r " << e.patch_radius_m
+                 << "), (" << e.patch2_x_m << ", " << e.patch2_y_m << ", r " << e.patch2_radius_m << "), r3 "
+                 << e.patch3_radius_m << "; held-out reduction " << r.heldout_rmse_reduction);
+  REQUIRE(r.selection.selected.size() == 1);
+  CHECK(r.selection.selected[0] == "grip_patch");
+  REQUIRE(e.patch2_radius_m > 0.0);
+  CHECK(e.patch3_radius_m == 0.0);
+  // The two discs on the two patches, in either order.
+  const double x_first = e.patch_x_m > 0 ? 8.0 : -8.0;
+  CHECK(std::hypot(e.patch_x_m - x_first, e.patch_y_m) < 1.5);
+  CHECK(std::hypot(e.patch2_x_m + x_first, e.patch2_y_m) < 1.5);
+  CHECK(e.patch_radius_m == Approx(3.0).margin(1.0));
+  CHECK(e.patch2_radius_m == Approx(3.0).margin(1.0));
+  CHECK(e.patch_grip_scale == Approx(0.5).margin(0.15));
+  CHECK(r.heldout_rmse_reduction > 0.3);
 }
