@@ -49,6 +49,8 @@
 //   force:    aero_drag                   extra force -c vx |vx|
 //             rolling_resistance          extra force -(F0 tanh(vx / 0.5) + b vx)
 //             road_grade                  a tilted plane z = gx x + gy y: -m g grad z
+//             ground_bump                 a hill (h > 0) or dip (h < 0) at a place: z = h (1 + cos(pi d /
+//                                         R)) / 2 within R of its centre, 0 beyond: -m g grad z
 // Every effect is off at its default value.
 #include <cmath>
 #include <limits>
@@ -103,6 +105,10 @@ struct EffectParams {
   double patch3_x_m = 0.0;           // [m] centre of a third disc of the same surface
   double patch3_y_m = 0.0;           // [m]
   double patch3_radius_m = 0.0;      // [m] its radius (0 = no third disc)
+  double bump_x_m = 0.0;             // [m] centre of the ground bump (world frame)
+  double bump_y_m = 0.0;             // [m]
+  double bump_radius_m = 0.0;        // [m] its radius (where the ground is level again)
+  double bump_height_m = 0.0;        // [m] its height at the centre (negative: a dip; 0 = none)
 
   bool is_valid(std::string* why) const;
 };
@@ -203,6 +209,11 @@ inline const std::vector<EffectSpec>& effect_table() {
         {"patch3_y_m", &E::patch3_y_m, "m", kAny, -1e9, 1e9, 1.0},
         {"patch3_radius_m", &E::patch3_radius_m, "m", kNonNeg, 0.0, 30.0, 0.5}},
        {}, DataGrid::kPlace, X::kCornering},
+      {"ground_bump", "a hill or dip on the ground: z = h (1 + cos(pi d / R)) / 2 within R of a place", H::kForce,
+       {{"bump_x_m", &E::bump_x_m, "m", kAny, -1e9, 1e9, 1.0},
+        {"bump_y_m", &E::bump_y_m, "m", kAny, -1e9, 1e9, 1.0},
+        {"bump_radius_m", &E::bump_radius_m, "m", kNonNeg, 0.0, 40.0, 0.5},
+        {"bump_height_m", &E::bump_height_m, "m", kAny, -2.0, 2.0, 0.05}}, {}, DataGrid::kPlace, X::kAny},
       {"load_transfer", "pitch load transfer: CG height h + dh", H::kChassis,
        {{"cg_height_delta_m", &E::cg_height_delta_m, "m", kAny, -0.115, 0.12, 0.02}}, {}, DataGrid::kNone, X::kBraking},
       {"motor_voltage_sag", "drive falls with current: throttle u - k max(u,0)^2", H::kActuator,

@@ -14,8 +14,8 @@
 //     discs (across a disc's edge the two steps are blended). Only for bases with such a core (the
 //     single-track and four-wheel models); the kinematic bicycle and the network have none, so
 //     these are refused;
-//   - force: aero_drag, rolling_resistance and road_grade add an acceleration along the body
-//     axes. A base that offers step_with_body_accel (the single-track model) takes it inside
+//   - force: aero_drag, rolling_resistance, road_grade and ground_bump add an acceleration along
+//     the body axes. A base that offers step_with_body_accel (the single-track model) takes it inside
 //     its force balance; for the others it is added to v_x (and v_y where the base has a
 //     lateral velocity) after the base step (operator splitting over one plant step). Mass: the
 //     base's own, or for bases without one the AutoRally car's (SingleTrackParams defaults; the
@@ -26,6 +26,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <numbers>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -94,6 +95,12 @@ class WithEffects {
                                              (car.wheel_radius_m * m * car.no_load_speed_mps));
     grade_x_ = static_cast<float>(g * effects_.grade_x);
     grade_y_ = static_cast<float>(g * effects_.grade_y);
+    bump_ = effects_.bump_height_m != 0.0 && effects_.bump_radius_m > 0.0;
+    bump_x_ = static_cast<float>(effects_.bump_x_m);
+    bump_y_ = static_cast<float>(effects_.bump_y_m);
+    bump_r_ = static_cast<float>(effects_.bump_radius_m);
+    // dz/dd = -h (pi / 2R) sin(pi d / R); times g for the acceleration
+    bump_slope_ = bump_ ? static_cast<float>(-g * effects_.bump_height_m * std::numbers::pi / (2.0 * effects_.bump_radius_m)) : 0.f;
     change_time_ = static_cast<float>(effects_.grip_change_time_s);
     grip_changes_ = effects_.grip_scale != 1.0;
     patch_ = effects_.patch_grip_scale != 1.0;
@@ -182,9 +189,11 @@ class WithEffects {
       // motor_freewheel: the share f of the base's back-EMF braking F_stall v / v_nl that the
       // command's off-time takes away, f (1 - |u|) F_stall v / v_nl.
       const float duty = std::min(std::abs(applied[control::kThrottle * W + j]), 1.f);
+      float gx = grade_x_, gy = grade_y_;  // g x the ground's slope here (plane + bump)
+      if (bump_) add_bump_slope(x[state::kX][j], x[state::kY][j], &gx, &gy);
       ax[j] = -drag_per_kg_ * vx * std::abs(vx) - roll_per_kg_ * phys::tanh(vx * 2.f) - visc_per_kg_ * vx -
-              (grade_x_ * cy + grade_y_ * sy) + freewheel_per_kg_ * (1.f - duty) * vx;
-      ay[j] = -(-grade_x_ * sy + grade_y_ * cy);
+              (gx * cy + gy * sy) + freewheel_per_kg_ * (1.f - duty) * vx;
+      ay[j] = -(-gx * sy + gy * cy);
       other_w[j] = other_grip_weight(x[kTime][j], x[state::kX][j], x[state::kY][j]);
       before_lanes += other_w[j] == 0.f;
       blended_lanes += other_w[j] > 0.f && other_w[j] < 1.f;
@@ -240,6 +249,15 @@ class WithEffects {
     if (z < -6.9f) return 1.f;
     return 1.f / (1.f + std::exp(z));
   }
+  // Adds g x the bump's slope (dz/dx, dz/dy) at (x, y) to (gx, gy).
+  void add_bump_slope(float x_m, float y_m, float* gx, float* gy) const noexcept {
+    const float dx = x_m - bump_x_, dy = y_m - bump_y_;
+    const float d = std::sqrt(dx * dx + dy * dy);
+    if (!(d < bump_r_) || d < 1e-6f) return;  // level beyond the radius; flat at the top
+    const float along = bump_slope_ * std::sin(static_cast<float>(std::numbers::pi) * d / bump_r_) / d;
+    *gx += along * dx;
+    *gy += along * dy;
+  }
   static double other_grip(const EffectParams& e) {
     if (e.grip_scale != 1.0 && e.patch_grip_scale != 1.0)
       throw Error("WithEffects: friction_change and grip_patch cannot be combined (one other grip)");
@@ -290,7 +308,8 @@ class WithEffects {
   EffectParams effects_;
   Base before_, after_;
   float drag_per_kg_ = 0, roll_per_kg_ = 0, visc_per_kg_ = 0, freewheel_per_kg_ = 0, grade_x_ = 0, grade_y_ = 0, change_time_ = 0;
-  bool grip_changes_ = false, patch_ = false;
+  bool grip_changes_ = false, patch_ = false, bump_ = false;
+  float bump_x_ = 0, bump_y_ = 0, bump_r_ = 0, bump_slope_ = 0;
   struct Disc {
     float x_m, y_m, radius_m;
   };

@@ -136,8 +136,12 @@ FitResult fit_place_effect(const FitProblem& p, const EffectParams& base, const 
       for (const EffectParams& v : variants)
         for (double f : {0.25, 0.6}) {
           EffectParams e = v;
-          // a size (from the default 0: a fraction of the range's top) or a strength (below and above 1)
-          e.*(q.member) = d == 0.0 ? q.lo + f * 0.4 * (q.hi - q.lo) : (f < 0.5 ? d * 0.6 : d * 1.6);
+          // a size (from the default 0: a fraction of the range's top), a signed amount (off at 0:
+          // as much each way) or a strength (below and above 1)
+          const bool signed_amount = d == 0.0 && q.lo < 0.0 && q.hi > 0.0;
+          e.*(q.member) = signed_amount ? 0.3 * (f < 0.5 ? q.lo : q.hi)
+                          : d == 0.0    ? q.lo + f * 0.4 * (q.hi - q.lo)
+                                        : (f < 0.5 ? d * 0.6 : d * 1.6);
           e.*(q.member) = std::clamp(e.*(q.member), q.lo, q.hi);
           next.push_back(e);
         }

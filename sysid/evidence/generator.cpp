@@ -28,11 +28,12 @@ std::string stem_of(const std::string& csv) {
   return csv.size() > 4 && csv.substr(csv.size() - 4) == ".csv" ? csv.substr(0, csv.size() - 4) : csv;
 }
 
-// The ground: grip discs on the track and a tilted plane, from the effects and the seed.
+// The ground: grip discs on the track, a bump and a tilted plane, from the effects and the seed.
 struct Ground {
   sim::SurfaceMap map;
   double grade_x = 0, grade_y = 0;
   std::vector<sim::SurfacePatch> patches;
+  sim::SurfacePatch bump;  // radius 0: none
 };
 
 Ground make_ground(const TruthEffects& e, const sim::Track& ccw, std::uint64_t seed) {
@@ -52,6 +53,18 @@ Ground make_ground(const TruthEffects& e, const sim::Track& ccw, std::uint64_t s
     p.edge_m = 1.0;
     p.value = e.grip_patch_scale;
     grip.patches.push_back(p);
+  }
+  if (e.bump_height_m != 0) {  // on the centreline, somewhere along the lap
+    const auto& arc = ccw.centreline_arc_m();
+    const double s = ccw.length_m() * uni(rng);
+    const auto it = std::upper_bound(arc.begin(), arc.end(), s);
+    const std::size_t k = static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, it - arc.begin() - 1)) % ccw.centreline().size();
+    sim::SurfacePatch hill;
+    hill.centre_m = ccw.centreline()[k];
+    hill.radius_m = e.bump_radius_m;
+    hill.value = e.bump_height_m;
+    elevation.patches.push_back(hill);
+    g.bump = hill;
   }
   if (e.grade != 0) {
     const double heading = 2 * std::numbers::pi * uni(rng);
@@ -247,6 +260,7 @@ EvidenceResult generate_evidence(const EvidenceOptions& o, const std::string& cs
       sizes["grade_x"] = ground.grade_x;
       sizes["grade_y"] = ground.grade_y;
     }
+    if (info.name == "bump") sizes["centre_m"] = {ground.bump.centre_m.x, ground.bump.centre_m.y};
     if (info.name == "grip_patches") {
       json discs = json::array();
       for (const auto& p : ground.patches)

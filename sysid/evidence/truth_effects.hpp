@@ -25,6 +25,9 @@ struct TruthEffects {
   double front_rolling_coefficient = 0, rear_rolling_coefficient = 0;  // per axle, x its load
   double payload_mass_scale = 1, payload_yaw_inertia_scale = 1;
   double grade = 0;               // a hill: constant grade dz/dx of the whole ground plane
+  // A bump: a raised-cosine hill of this height [m] (negative: a dip) and radius on the track.
+  double bump_height_m = 0;
+  double bump_radius_m = 12;
   // Grip patches: `grip_patches` discs of grip `grip_patch_scale` on the track (0 = none).
   int grip_patches = 0;
   double grip_patch_scale = 1;

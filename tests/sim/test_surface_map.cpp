@@ -1,7 +1,8 @@
 // Surface maps (sim/surface_map.hpp) and the single-track plant on them (sim/surface_plant.hpp)
 // against closed forms: patch values and blends, raised-cosine hills, bilinear image lookup,
 // a constant grade changing the acceleration by g sin(theta), and a low-grip patch capping the
-// tyre force at mu_peak x scale x F_z on the patch only.
+// tyre force at mu_peak x scale x F_z on the patch only. The diagnosis' ground_bump effect is
+// checked against the surface plant's hill (its own slope by central differences).
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <memory>
 
 #include "dynamics/single_track.hpp"
+#include "dynamics/with_effects.hpp"
 #include "mppi/error.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/recording.hpp"
@@ -123,6 +125,48 @@ TEST_CASE("surface plant: a constant grade changes the acceleration by g sin(the
     const double along = -9.81 * std::sin(theta) * std::cos(yaw);  // uphill at yaw 0, downhill at pi, across at pi/2
     CHECK((a[state::kVx] - b[state::kVx]) / dt == Approx(along).margin(2e-3));
   }
+}
+
+TEST_CASE("the corrected model's ground bump drives like the surface plant's raised-cosine hill", "[surface][effects]") {
+  // A 0.6 m hill of radius 10 m; the car starts 14 m away heading past its centre (off-centre by
+  // 3 m, so the slope also pushes sideways) at 6 m/s and drives over it for 4 s.
+  SurfaceLayer elevation;
+  SurfacePatch hill;
+  hill.centre_m = {14.0, 3.0};
+  hill.radius_m = 10.0;
+  hill.value = 0.6;
+  elevation.patches.push_back(hill);
+  const SingleTrackParams p;
+  const SingleTrackOnSurface plant(p, std::make_shared<const SurfaceMap>(SurfaceLayer{1.0}, elevation));
+  EffectParams e;
+  e.bump_x_m = 14.0;
+  e.bump_y_m = 3.0;
+  e.bump_radius_m = 10.0;
+  e.bump_height_m = 0.6;
+  const CorrectedSingleTrack corrected{SingleTrack(p), e}, flat{SingleTrack(p)};
+  VehicleState s;
+  s.vx_mps = 6.f;
+  float a[SingleTrack::kNx], b[CorrectedSingleTrack::kNx], c[CorrectedSingleTrack::kNx];
+  plant.init_state(s, a);
+  corrected.init_state(s, b);
+  flat.init_state(s, c);
+  const float u[2] = {0.02f, 0.25f};
+  corrected.set_actuators(b, u[0], u[1]);
+  flat.set_actuators(c, u[0], u[1]);
+  std::vector<float> scratch(std::max<std::size_t>(1, corrected.scratch_floats(1)));
+  double worst_vx = 0, worst_vy = 0, flat_vx = 0;
+  for (int k = 0; k < 2000; ++k) {
+    plant.step<1>(Batch<SingleTrack::kNx, 1>{a}, ConstBatch<2, 1>{u}, 0.002f, nullptr);
+    corrected.step<1>(Batch<CorrectedSingleTrack::kNx, 1>{b}, ConstBatch<2, 1>{u}, 0.002f, scratch.data());
+    flat.step<1>(Batch<CorrectedSingleTrack::kNx, 1>{c}, ConstBatch<2, 1>{u}, 0.002f, scratch.data());
+    worst_vx = std::max(worst_vx, static_cast<double>(std::abs(a[state::kVx] - b[state::kVx])));
+    worst_vy = std::max(worst_vy, static_cast<double>(std::abs(a[state::kVy] - b[state::kVy])));
+    flat_vx = std::max(flat_vx, static_cast<double>(std::abs(a[state::kVx] - c[state::kVx])));
+  }
+  INFO("worst |dvx| " << worst_vx << " m/s, |dvy| " << worst_vy << " m/s; flat ground differs by " << flat_vx);
+  CHECK(flat_vx > 0.3);                // the hill is felt: up to 9 % grade over 4 s
+  CHECK(worst_vx < 0.02 * flat_vx);    // the two forms agree (sin vs tan of the slope: < 0.5 %)
+  CHECK(worst_vy < 0.02);
 }
 
 TEST_CASE("surface plant: on a low-grip patch the tyre force is capped at mu_peak x scale x Fz, off it not", "[surface]") {

@@ -1,0 +1,64 @@
+// The diagnosis names a hill at a place (ground_bump) on a recording of the independent evidence
+// generator, whose hill is an elevation disc of the simulator's surface map (other code: slope by
+// central differences, gravity as g sin(theta)), and finds its place, radius and height.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "sysid/diagnose/diagnose.hpp"
+#include "sysid/diagnose/model_family.hpp"
+#include "sysid/diagnose/data.hpp"
+#include "sysid/evidence/generator.hpp"
+#include "sysid/evidence/truth_effects.hpp"
+#include "test_data.hpp"
+
+using namespace mppi;
+using namespace mppi::diagnose;
+
+TEST_CASE("a raised-cosine hill on the track is named as a ground bump at its place", "[diagnose][slow]") {
+  const auto dir = std::filesystem::temp_directory_path() / "mppi_ground_bump_test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  evidence::EvidenceOptions o;
+  o.duration_s = 40;
+  o.seed = 1;
+  o.track = "gazebo";
+  o.direction = "ccw";
+  o.driver = "pursuit";
+  o.vehicle_yaml = mppi::test::data_path("config/autorally_single_track.yaml");
+  o.truth_names = evidence::set_truth_effects("bump_height_m=0.6,bump_radius_m=12", &o.truth);
+  const evidence::EvidenceResult rec = evidence::generate_evidence(o, (dir / "bump.csv").string());
+
+  // The hill's centre from the truth file: "centre_m": [x, y].
+  std::ifstream truth_file(rec.truth_json);
+  const std::string truth((std::istreambuf_iterator<char>(truth_file)), std::istreambuf_iterator<char>());
+  const std::size_t at = truth.find("\"centre_m\"");
+  REQUIRE(at != std::string::npos);
+  const std::size_t open = truth.find('[', at);
+  const std::size_t comma = truth.find(',', open);
+  const double cx = std::stod(truth.substr(open + 1, comma - open - 1));
+  const double cy = std::stod(truth.substr(comma + 1));
+
+  const DiagData d = load_recording(rec.csv);
+  DiagnoseOptions opt;
+  opt.plots = false;
+  const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track", rec.vehicle_yaml), opt);
+  std::string named;
+  for (const auto& s : r.selection.selected) named += s + " ";
+  const EffectParams& e = r.selection.final_effects;
+  INFO("named: " << named << "; truth centre (" << cx << ", " << cy << "); fitted (" << e.bump_x_m << ", "
+                 << e.bump_y_m << "), radius " << e.bump_radius_m << ", height " << e.bump_height_m
+                 << "; held-out reduction " << r.heldout_rmse_reduction);
+  REQUIRE(r.selection.selected.size() == 1);
+  CHECK(r.selection.selected[0] == "ground_bump");
+  CHECK(std::hypot(e.bump_x_m - cx, e.bump_y_m - cy) < 1.5);
+  CHECK(e.bump_radius_m == Approx(12.0).margin(1.5));
+  CHECK(e.bump_height_m == Approx(0.6).margin(0.1));
+  CHECK(r.heldout_rmse_reduction > 0.3);
+  std::filesystem::remove_all(dir);
+}
