@@ -276,16 +276,17 @@ inline constexpr OptionalDisc kOptionalPatchDiscs[] = {
     {&EffectParams::patch2_x_m, &EffectParams::patch2_y_m, &EffectParams::patch2_radius_m},
     {&EffectParams::patch3_x_m, &EffectParams::patch3_y_m, &EffectParams::patch3_radius_m},
 };
-inline bool is_optional_disc_param(const EffectParamSpec& p) {
+// The optional disc a parameter belongs to, or nullptr for every other parameter.
+inline const OptionalDisc* optional_disc_of(const EffectParamSpec& p) {
   for (const OptionalDisc& d : kOptionalPatchDiscs)
-    if (p.member == d.x || p.member == d.y || p.member == d.radius) return true;
-  return false;
+    if (p.member == d.x || p.member == d.y || p.member == d.radius) return &d;
+  return nullptr;
 }
+inline bool is_optional_disc_param(const EffectParamSpec& p) { return optional_disc_of(p) != nullptr; }
 // False for a parameter of an optional disc that `e` does not have; true for every other one.
 inline bool effect_param_active(const EffectParamSpec& p, const EffectParams& e) {
-  for (const OptionalDisc& d : kOptionalPatchDiscs)
-    if (p.member == d.x || p.member == d.y || p.member == d.radius) return e.*(d.radius) > 0.0;
-  return true;
+  const OptionalDisc* d = optional_disc_of(p);
+  return !d || e.*(d->radius) > 0.0;
 }
 
 // The effect parameters as a parameter table (keys as in the corrected-model file).
@@ -299,7 +300,9 @@ inline std::vector<ParamField> param_table(EffectParams& e) {
 
 inline bool EffectParams::is_valid(std::string* why) const {
   EffectParams copy = *this;
-  const std::string error = first_range_error(param_table(copy));
+  std::string error = first_range_error(param_table(copy));
+  if (error.empty() && bump_height_m != 0.0 && !(bump_radius_m > 0.0))
+    error = "bump_height_m = " + std::to_string(bump_height_m) + " needs bump_radius_m > 0 (the bump's extent)";
   if (!error.empty() && why) *why = error;
   return error.empty();
 }

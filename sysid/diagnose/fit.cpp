@@ -76,10 +76,6 @@ std::vector<std::pair<double, double>> spread_places(const FitProblem& p, int co
   return chosen;
 }
 
-}  // namespace
-
-namespace {
-
 // The estimates in the order of spec.params: the fitted ones from `fit`, every other parameter at
 // its value in fit.effects with no spread (an optional disc that is not there).
 std::vector<ParamEstimate> in_spec_order(const EffectSpec& spec, const FitResult& fit) {
@@ -163,11 +159,10 @@ FitResult fit_place_effect(const FitProblem& p, const EffectParams& base, const 
     if (r.cost < best.cost) best = r;
   }
   for (const OptionalDisc& disc : kOptionalPatchDiscs) {
-    const bool of_this_effect = std::any_of(spec.params.begin(), spec.params.end(),
-                                            [&](const EffectParamSpec& q) { return q.member == disc.radius; });
-    if (!of_this_effect || !std::isfinite(best.cost)) break;
-    const EffectParamSpec& radius = *std::find_if(spec.params.begin(), spec.params.end(),
-                                                  [&](const EffectParamSpec& q) { return q.member == disc.radius; });
+    const auto radius_spec = std::find_if(spec.params.begin(), spec.params.end(),
+                                          [&](const EffectParamSpec& q) { return q.member == disc.radius; });
+    if (radius_spec == spec.params.end() || !std::isfinite(best.cost)) break;  // not this effect's disc
+    const EffectParamSpec& radius = *radius_spec;
     starts.clear();
     for (const auto& [x, y] : places)
       for (double f : {0.25, 0.6}) {

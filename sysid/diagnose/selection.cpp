@@ -28,8 +28,8 @@ std::vector<ParamSpec> joint_free_params(const std::vector<const EffectSpec*>& c
   std::vector<ParamSpec> free;
   for (int i : chosen) {
     const EffectSpec& s = *cands[static_cast<std::size_t>(i)];
-    for (std::size_t j = 0; j < s.params.size(); ++j)
-      if (!(s.data_grid == DataGrid::kTime && j == 0) && effect_param_active(s.params[j], at)) free.push_back(s.params[j]);
+    for (const ParamSpec& q : active_params(s, at))
+      if (!(s.data_grid == DataGrid::kTime && q.member == s.params[0].member)) free.push_back(q);
   }
   return free;
 }

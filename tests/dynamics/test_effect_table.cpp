@@ -71,6 +71,14 @@ TEST_CASE("effect parameters are validated from the table with the key named", "
   e = {};
   e.aero_drag_kgpm = std::nan("");
   CHECK_FALSE(e.is_valid(&why));
+  e = {};  // a bump needs an extent
+  e.bump_height_m = 0.4;
+  CHECK_FALSE(e.is_valid(&why));
+  CHECK(why.find("bump_radius_m") != std::string::npos);
+  e.bump_radius_m = 5.0;
+  CHECK(e.is_valid(&why));
+  CHECK_THROWS_WITH(corrected_model_from_yaml("effects:\n  bump_height_m: 0.4\n", "bump.yaml"),
+                    Catch::Contains("bump.yaml") && Catch::Contains("bump_radius_m"));
   CHECK_THROWS_WITH(corrected_model_from_yaml("effects:\n  voltage_sag: 1.5\n", "sag.yaml"),
                     Catch::Contains("sag.yaml:2") && Catch::Contains("voltage_sag"));
 }

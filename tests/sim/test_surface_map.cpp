@@ -137,7 +137,9 @@ TEST_CASE("the corrected model's ground bump drives like the surface plant's rai
   hill.value = 0.6;
   elevation.patches.push_back(hill);
   const SingleTrackParams p;
-  const SingleTrackOnSurface plant(p, std::make_shared<const SurfaceMap>(SurfaceLayer{1.0}, elevation));
+  SurfaceLayer grip;
+  grip.default_value = 1.0;
+  const SingleTrackOnSurface plant(p, std::make_shared<const SurfaceMap>(grip, elevation));
   EffectParams e;
   e.bump_x_m = 14.0;
   e.bump_y_m = 3.0;

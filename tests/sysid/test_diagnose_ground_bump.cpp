@@ -2,12 +2,12 @@
 // generator, whose hill is an elevation disc of the simulator's surface map (other code: slope by
 // central differences, gravity as g sin(theta)), and finds its place, radius and height.
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <string>
 
 #include "sysid/diagnose/diagnose.hpp"
@@ -34,15 +34,11 @@ TEST_CASE("a raised-cosine hill on the track is named as a ground bump at its pl
   o.truth_names = evidence::set_truth_effects("bump_height_m=0.6,bump_radius_m=12", &o.truth);
   const evidence::EvidenceResult rec = evidence::generate_evidence(o, (dir / "bump.csv").string());
 
-  // The hill's centre from the truth file: "centre_m": [x, y].
+  // The hill's centre from the truth file: effects[0].sizes.centre_m = [x, y].
   std::ifstream truth_file(rec.truth_json);
-  const std::string truth((std::istreambuf_iterator<char>(truth_file)), std::istreambuf_iterator<char>());
-  const std::size_t at = truth.find("\"centre_m\"");
-  REQUIRE(at != std::string::npos);
-  const std::size_t open = truth.find('[', at);
-  const std::size_t comma = truth.find(',', open);
-  const double cx = std::stod(truth.substr(open + 1, comma - open - 1));
-  const double cy = std::stod(truth.substr(comma + 1));
+  const nlohmann::json truth = nlohmann::json::parse(truth_file);
+  const auto& centre = truth.at("effects").at(0).at("sizes").at("centre_m");
+  const double cx = centre.at(0).get<double>(), cy = centre.at(1).get<double>();
 
   const DiagData d = load_recording(rec.csv);
   DiagnoseOptions opt;
