@@ -6,6 +6,7 @@
 //   mppi-fit diagnose sweep [...]          seeds x effects x sizes: named right / wrong, RMSE
 //   mppi-fit diagnose loop [...]           closed loop: MPPI with nominal vs corrected model
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -79,7 +80,7 @@ struct DiagnoseArgs {
   std::vector<std::string> logs, validates;
   std::string params, model = mppi::models::SingleTrackModel::kName, effects;
   DiagnoseOptions o;
-  bool no_plots = false;
+  bool no_plots = false, quiet = false;
   DiagnoseArgs() { o.out_dir = "out/diagnose"; }
 };
 
@@ -88,6 +89,13 @@ int cmd_diagnose(DiagnoseArgs& args) {
   DiagnoseOptions o = args.o;
   o.selection.candidates = split_list(args.effects);
   o.plots = !args.no_plots;
+  if (!args.quiet) {  // the selection takes minutes: its log as it is written, with the elapsed time
+    const auto start = std::chrono::steady_clock::now();
+    o.selection.progress = [start](const std::string& line) {
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::fprintf(stderr, "[%6.1f s] %s\n", s, line.c_str());
+    };
+  }
   if (args.logs.empty()) throw usage_error("--log", "a recording (--log FILE) is required");
   for (const auto& id : o.selection.candidates) effect_spec(id);  // throws for unknown ids
   const auto nominal = make_model_family(model, params);  // throws for other models, bad files
@@ -328,7 +336,8 @@ void add_diagnose_options(CLI::App& cmd, DiagnoseArgs& a) {
   mppi::cli::add_model_option(cmd, "--model", a.model, "nominal model", nominal_models());
   cmd.add_option("--params", a.params,
                  "nominal parameters: that model's YAML (keys: mppi-sim --list-models) or a corrected-model file "
-                 "(default: the library defaults, e.g. data/config/autorally_single_track.yaml)")
+                 "(default: the model's built-in defaults, listed by mppi-sim --list-models; these are not the shipped "
+                 "data/config files: pass --params data/config/autorally_single_track.yaml for the simulator's default plant)")
       ->type_name("FILE");
   cmd.add_option("--holdout", a.o.holdout, "held-out fraction at the end, or time range T0:T1 [s]")->type_name("H");
   cmd.add_option("--validate", a.validates,
@@ -342,6 +351,7 @@ void add_diagnose_options(CLI::App& cmd, DiagnoseArgs& a) {
   cmd.add_option("--min-bic-drop", a.o.selection.min_bic_drop, "and BIC decrease")->type_name("B");
   mppi::cli::add_out_option(cmd, a.o.out_dir, "report.json, report.md, PNG plots, corrected_model.yaml");
   cmd.add_flag("--no-plots", a.no_plots, "skip the PNG plots");
+  cmd.add_flag("--quiet", a.quiet, "no progress on stderr (the selection log as it is written)");
 }
 
 // `--generator independent` is taken before parsing (apps/mppi_fit.cpp): listed here for --help.

@@ -5,6 +5,7 @@
 // validation segments with the BIC, so that an effect that does not help is not named.
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -92,6 +93,9 @@ struct SelectionOptions {
   // Among near-best candidates of as many parameters, one whose BIC on the fit part is lower by
   // at least this ("strong evidence" on the Kass-Raftery scale) goes first.
   double strong_bic_evidence = 6.0;
+  // Called with each line of the selection log as it is written, and with the stability
+  // resamples' progress (a run takes minutes): progress output. Empty = silent.
+  std::function<void(const std::string&)> progress;
 };
 
 struct CandidateReport {

@@ -80,12 +80,26 @@ struct Folds {
   const FitProblem& early_val;
 };
 
+// The selection log: keeps each line (Selection::log) and echoes it as progress when asked.
+class SelectionLog {
+ public:
+  SelectionLog(std::vector<std::string>* lines, const SelectionOptions& opt) : lines_(lines), progress_(&opt.progress) {}
+  void push_back(const std::string& line) {
+    if (lines_) lines_->push_back(line);
+    if (*progress_) (*progress_)(line);
+  }
+
+ private:
+  std::vector<std::string>* lines_;
+  const std::function<void(const std::string&)>* progress_;
+};
+
 // The library effects a candidate stands for: itself, or for a joint candidate its two partners.
 using Members = std::vector<std::vector<int>>;
 
 GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& cands, const Members& members,
                     const std::vector<int>& pool, const SelectionOptions& opt, double n_eff,
-                    std::vector<std::string>* log) {
+                    SelectionLog* log) {
   const FitProblem& fit = folds.fit;
   const FitProblem& val = folds.val;
   GreedyResult out;
@@ -277,6 +291,7 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
                          const std::vector<char>& heldout_mask, const SelectionOptions& opt,
                          const ReplayOptions& replay) {
   Selection sel;
+  SelectionLog log(&sel.log, opt);
   const int len = std::max(2, static_cast<int>(std::lround(opt.fit_horizon_s / d.dt_s)));
   const auto segs = make_segments(d, train_mask, len, len);
   if (segs.size() < 6)
@@ -304,7 +319,7 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
   char line[512];
   std::snprintf(line, sizeof line, "fit on %zu segments of %.2f s up to t = %.1f s, validated on the %zu after",
                 fit.segments.size(), len * d.dt_s, d.t[fit.segments.back().start], val.segments.size());
-  sel.log.push_back(line);
+  log.push_back(line);
 
   // Candidates, and which of them this recording can identify at all.
   std::vector<const EffectSpec*> cands;
@@ -353,13 +368,13 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
     if (sel.candidates[i].not_testable.empty())
       pool.push_back(static_cast<int>(i));
     else
-      sel.log.push_back(cands[i]->id + " not testable: " + sel.candidates[i].not_testable);
+      log.push_back(cands[i]->id + " not testable: " + sel.candidates[i].not_testable);
   }
 
   const auto nominal_model = nominal.make({});
   const double held_nominal = heldout_1s_normalized_rmse(*nominal_model, d, heldout_mask, replay);
   const Folds folds{fit, val, early_fit, early_val};
-  const GreedyResult main = greedy(folds, cands, members, pool, opt, n_eff, &sel.log);
+  const GreedyResult main = greedy(folds, cands, members, pool, opt, n_eff, &log);
   for (const CandidateFit& c : main.first_round) {
     CandidateReport& r = sel.candidates[static_cast<std::size_t>(c.index)];
     r.params = c.fit.params;
@@ -399,6 +414,8 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
     for (int b = 0; b < opt.stability_resamples; ++b) {
       FitProblem fit_b = fit;
       fit_b.segments = resample_blocks(fit.segments, block, rng);
+      if (opt.progress)
+        opt.progress("stability: resample " + std::to_string(b + 1) + " of " + std::to_string(opt.stability_resamples) + "...");
       const GreedyResult g = greedy({fit_b, val, early_fit, early_val}, cands, members, stable_pool, opt, n_eff, nullptr);
       for (int i : g.chosen) ++inclusion[static_cast<std::size_t>(i)];
     }
@@ -413,7 +430,7 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
       r.inclusion_frequency = static_cast<double>(inclusion[static_cast<std::size_t>(i)]) / opt.stability_resamples;
       std::snprintf(line, sizeof line, "stability: %s chosen in %d of %d resamples", r.id.c_str(),
                     inclusion[static_cast<std::size_t>(i)], opt.stability_resamples);
-      sel.log.push_back(line);
+      log.push_back(line);
     }
   }
   std::vector<std::string> named;
@@ -436,7 +453,7 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
       if (std::find(named.begin(), named.end(), r.id) != named.end()) continue;
       std::snprintf(line, sizeof line, "stable: %s chosen in %.0f %% of the resamples, named though not chosen on all the data",
                     r.id.c_str(), 100 * r.inclusion_frequency);
-      sel.log.push_back(line);
+      log.push_back(line);
       named.push_back(r.id);
     }
 
@@ -467,7 +484,7 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
       } else {
         for (std::size_t i = 0; i < cands.size(); ++i)
           if (cands[i]->id == id) suspect(static_cast<int>(i), "not identifiable from this recording: " + limit, joint.effects);
-        sel.log.push_back("joint refit: " + id + " not identified: " + limit);
+        log.push_back("joint refit: " + id + " not identified: " + limit);
       }
     }
     if (keep.size() == named.size()) {
@@ -509,7 +526,7 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
       sel.final_effects = {};
       sel.final_params.clear();
       sel.verdict = std::string("no reliable correction: ") + line;
-      sel.log.push_back(sel.verdict);
+      log.push_back(sel.verdict);
       return sel;
     }
   }
@@ -522,7 +539,7 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
       for (const auto& id : sel.selected) s += (s.empty() ? "" : ", ") + id;
       return s;
     }();
-  sel.log.push_back(sel.verdict);
+  log.push_back(sel.verdict);
   return sel;
 }
 

@@ -25,13 +25,14 @@ using namespace mppi::diagnose;
 namespace {
 
 DiagnoseResult diagnose_synthetic(const std::string& truth_text, std::uint64_t seed, std::vector<std::string>* ids,
-                                  const std::string& out_dir = "") {
+                                  const std::string& out_dir = "", std::vector<std::string>* progress = nullptr) {
   EffectParams truth;
   *ids = parse_effect_assignments(truth_text, &truth);
   const DiagData d = prepare(synthesize_open_loop(truth, seed, 40.0), "synthetic " + truth_text);
   DiagnoseOptions o;
   o.out_dir = out_dir;
   o.plots = !out_dir.empty();
+  if (progress) o.selection.progress = [progress](const std::string& line) { progress->push_back(line); };
   return run_diagnosis(d, *make_model_family("single-track"), o);
 }
 
@@ -87,7 +88,13 @@ TEST_CASE("two hidden effects at once are both named; report and model file agre
   const auto dir = std::filesystem::temp_directory_path() / "mppi_test_diagnose_two";
   std::filesystem::remove_all(dir);
   std::vector<std::string> ids;
-  const DiagnoseResult r = diagnose_synthetic("steer_delay_s=0.08,throttle_lag_s=0.25", 31, &ids, dir.string());
+  std::vector<std::string> progress;
+  const DiagnoseResult r = diagnose_synthetic("steer_delay_s=0.08,throttle_lag_s=0.25", 31, &ids, dir.string(), &progress);
+  // Progress: the selection log line by line as it is written, and each stability resample.
+  std::vector<std::string> logged, resamples;
+  for (const auto& line : progress) (line.rfind("stability: resample ", 0) == 0 ? resamples : logged).push_back(line);
+  CHECK(logged == r.selection.log);
+  CHECK(static_cast<int>(resamples.size()) == SelectionOptions{}.stability_resamples);
   std::vector<std::string> named = r.selection.selected;
   std::sort(named.begin(), named.end());
   std::sort(ids.begin(), ids.end());
