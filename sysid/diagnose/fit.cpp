@@ -227,7 +227,9 @@ FitResult fit_params(const FitProblem& p, const EffectParams& base, const std::v
     res.iterations = it + 1;
     jacobian_at(v);
     const Eigen::Map<const Eigen::VectorXd> rv(r0.data(), static_cast<Eigen::Index>(n));
-    const Eigen::MatrixXd A = J.transpose() * J;
+    // lazyProduct: a few parameters against thousands of residuals is a handful of dot products;
+    // Eigen's GEMM would open an OpenMP team inside each parallel candidate fit.
+    const Eigen::MatrixXd A = J.transpose().lazyProduct(J);
     const Eigen::VectorXd g = J.transpose() * rv;
     bool improved = false;
     for (int tries = 0; tries < 8; ++tries) {
@@ -260,7 +262,7 @@ FitResult fit_params(const FitProblem& p, const EffectParams& base, const std::v
   if (np > 0 && n > static_cast<std::size_t>(np) && std::isfinite(c0)) {
     jacobian_at(v);
     const double s2 = c0 * static_cast<double>(n) / static_cast<double>(n - static_cast<std::size_t>(np)) * 5.0;
-    const Eigen::MatrixXd A = J.transpose() * J;
+    const Eigen::MatrixXd A = J.transpose().lazyProduct(J);
     cov = A.completeOrthogonalDecomposition().pseudoInverse() * s2;
   }
   for (int i = 0; i < np; ++i) {

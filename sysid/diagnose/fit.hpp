@@ -93,8 +93,9 @@ struct SelectionOptions {
   // Among near-best candidates of as many parameters, one whose BIC on the fit part is lower by
   // at least this ("strong evidence" on the Kass-Raftery scale) goes first.
   double strong_bic_evidence = 6.0;
-  // Called with each line of the selection log as it is written, and with the stability
-  // resamples' progress (a run takes minutes): progress output. Empty = silent.
+  // Called with each line of the selection log as it is written, and as each stability resample
+  // finishes (a run takes minutes): progress output. Empty = silent. Calls come one at a time,
+  // but not always from the calling thread.
   std::function<void(const std::string&)> progress;
 };
 

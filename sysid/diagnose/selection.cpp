@@ -6,8 +6,11 @@
 #include <cstdio>
 #include <deque>
 #include <limits>
+#include <mutex>
 #include <optional>
 #include <random>
+
+#include <tbb/parallel_for.h>
 
 #include "mppi/error.hpp"
 #include "sysid/diagnose/fit.hpp"
@@ -54,6 +57,7 @@ struct CandidateFit {
   double val_cost = 0, improvement = 0, bic = 0;
   bool passes = false;
   bool judged_early = false;  // passed on the earlier fold (the later block could not judge it)
+  std::string earlier_fold;   // for the log: the earlier fold's verdict where it was asked
 };
 
 struct GreedyResult {
@@ -108,38 +112,48 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
   std::vector<bool> taken(cands.size(), false);
   char line[512];
   for (int round = 1; round <= opt.max_effects; ++round) {
-    std::vector<CandidateFit> tried;
-    for (int i : pool) {
-      if (taken[static_cast<std::size_t>(i)]) continue;
-      CandidateFit c;
+    // The candidates of a round are fitted independently of each other (each on its own copy of
+    // the model), so in parallel; the log and the ranking then go through them in pool order, so
+    // the result does not depend on the number of threads.
+    std::vector<int> todo;
+    for (int i : pool)
+      if (!taken[static_cast<std::size_t>(i)]) todo.push_back(i);
+    std::vector<CandidateFit> tried(todo.size());
+    tbb::parallel_for(std::size_t(0), todo.size(), [&](std::size_t n) {
+      const int i = todo[n];
+      const EffectSpec& spec = *cands[static_cast<std::size_t>(i)];
+      CandidateFit& c = tried[n];
       c.index = i;
-      c.fit = fit_effect(fit, base, *cands[static_cast<std::size_t>(i)]);
+      c.fit = fit_effect(fit, base, spec);
       c.val_cost = mean_cost(val, c.fit.effects);
-      const double k = static_cast<double>(cands[static_cast<std::size_t>(i)]->params.size());
+      const double k = static_cast<double>(spec.params.size());
       c.bic = n_eff * std::log(c.fit.cost / base_fit) + k * std::log(n_eff);
       c.improvement = 1.0 - c.val_cost / base_val;
       c.passes = c.improvement >= opt.min_val_improvement && c.bic <= -opt.min_bic_drop && c.val_cost < base_val;
-      char earlier[96] = "";
       if (!c.passes && c.bic <= -opt.min_bic_drop && c.improvement >= 0.0 && c.improvement < opt.inconclusive_share &&
           !folds.early_val.segments.empty()) {
-        const FitResult early = fit_effect(folds.early_fit, base, *cands[static_cast<std::size_t>(i)]);
+        const FitResult early = fit_effect(folds.early_fit, base, spec);
         const double early_base = mean_cost(folds.early_val, base);
         const double early_improvement = early_base > 0 ? 1.0 - mean_cost(folds.early_val, early.effects) / early_base : 0.0;
-        std::snprintf(earlier, sizeof earlier, " (later block inconclusive; earlier fold %+.1f %%)", 100 * early_improvement);
+        char note[96];
+        std::snprintf(note, sizeof note, " (later block inconclusive; earlier fold %+.1f %%)", 100 * early_improvement);
+        c.earlier_fold = note;
         if (early_improvement >= opt.min_val_improvement) {
           c.improvement = early_improvement;
           c.passes = true;
           c.judged_early = true;
         }
       }
+    });
+    for (const CandidateFit& c : tried) {
       if (log) {
         std::snprintf(line, sizeof line, "round %d: %-20s validation %+6.1f %%, dBIC %+9.1f%s%s", round,
-                      cands[static_cast<std::size_t>(i)]->id.c_str(), 100 * (1.0 - c.val_cost / base_val), c.bic,
-                      earlier, c.passes ? "  passes" : "");
+                      cands[static_cast<std::size_t>(c.index)]->id.c_str(), 100 * (1.0 - c.val_cost / base_val), c.bic,
+                      c.earlier_fold.c_str(), c.passes ? "  passes" : "");
         log->push_back(line);
       }
-      if (c.passes && std::find(out.passed.begin(), out.passed.end(), i) == out.passed.end()) out.passed.push_back(i);
-      tried.push_back(std::move(c));
+      if (c.passes && std::find(out.passed.begin(), out.passed.end(), c.index) == out.passed.end())
+        out.passed.push_back(c.index);
     }
     if (round == 1) out.first_round = tried;
     // Improvements on different blocks do not compare: what passed on the later block (the main
@@ -411,14 +425,21 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
   if (!main.chosen.empty() && opt.stability_resamples > 0) {
     std::mt19937_64 rng(opt.seed * 0x9E3779B97F4A7C15ull + 17);
     const int block = std::max(2, static_cast<int>(std::lround(2.0 / (len * d.dt_s))));  // about 2 s
-    for (int b = 0; b < opt.stability_resamples; ++b) {
-      FitProblem fit_b = fit;
-      fit_b.segments = resample_blocks(fit.segments, block, rng);
-      if (opt.progress)
-        opt.progress("stability: resample " + std::to_string(b + 1) + " of " + std::to_string(opt.stability_resamples) + "...");
-      const GreedyResult g = greedy({fit_b, val, early_fit, early_val}, cands, members, stable_pool, opt, n_eff, nullptr);
-      for (int i : g.chosen) ++inclusion[static_cast<std::size_t>(i)];
-    }
+    // The resamples are drawn in order (one random stream), then selected on in parallel.
+    std::vector<FitProblem> resampled(static_cast<std::size_t>(opt.stability_resamples), fit);
+    for (FitProblem& fit_b : resampled) fit_b.segments = resample_blocks(fit.segments, block, rng);
+    std::vector<std::vector<int>> chosen(resampled.size());
+    std::mutex progress_mutex;
+    int done = 0;
+    tbb::parallel_for(std::size_t(0), resampled.size(), [&](std::size_t b) {
+      chosen[b] = greedy({resampled[b], val, early_fit, early_val}, cands, members, stable_pool, opt, n_eff, nullptr).chosen;
+      if (opt.progress) {
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        opt.progress("stability: resample " + std::to_string(++done) + " of " + std::to_string(opt.stability_resamples) + " done");
+      }
+    });
+    for (const auto& c : chosen)
+      for (int i : c) ++inclusion[static_cast<std::size_t>(i)];
     std::vector<int> reported;  // the library effects that the pool and the main selection stand for
     for (int i : stable_pool)
       for (int m : members[static_cast<std::size_t>(i)])
