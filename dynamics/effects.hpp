@@ -129,10 +129,6 @@ struct EffectParamSpec {
   Range valid;                  // values a model accepts (is_valid)
   double lo, hi;                // range a fit searches (fits are projected onto it)
   double scale;                 // typical size: finite-difference step = 0.01 scale
-  // One term of a law of several that may be absent on its own (Coulomb and viscous parts of a
-  // resistance): where a fit drives it to an end of its search range, the effect is refitted
-  // with the term at its off value instead of being set aside.
-  bool optional_term = false;
 };
 
 // What a recording must contain for an effect to be identifiable from it (the diagnosis
@@ -178,8 +174,8 @@ inline const std::vector<EffectSpec>& effect_table() {
       {"aero_drag", "extra air drag F = -c vx|vx|", H::kForce,
        {{"aero_drag_kgpm", &E::aero_drag_kgpm, "N s^2/m^2", kAny, -0.05, 3.0, 0.1}}, {}, DataGrid::kNone, X::kSpeedRange},
       {"rolling_resistance", "extra rolling resistance F = -(F0 tanh(vx/0.5) + b vx)", H::kForce,
-       {{"rolling_force_N", &E::rolling_force_N, "N", kAny, -10.0, 60.0, 2.0, true},
-        {"rolling_viscous_Nspm", &E::rolling_viscous_Nspm, "N s/m", kAny, -5.0, 30.0, 1.0, true}}, {}, DataGrid::kNone, X::kSpeedRange},
+       {{"rolling_force_N", &E::rolling_force_N, "N", kAny, -10.0, 60.0, 2.0},
+        {"rolling_viscous_Nspm", &E::rolling_viscous_Nspm, "N s/m", kAny, -5.0, 30.0, 1.0}}, {}, DataGrid::kNone, X::kSpeedRange},
       {"steer_delay", "pure delay of the steering command", H::kActuator,
        {{"steer_delay_s", &E::steer_delay_s, "s", kNonNeg, 0.0, 0.4, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25}, DataGrid::kNone, X::kSteer},
       {"throttle_delay", "pure delay of the throttle command", H::kActuator,

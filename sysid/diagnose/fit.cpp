@@ -24,7 +24,6 @@ std::size_t used_param_count(const EffectSpec& spec, const FitResult& fit) {
     }
     const double off = defaults.*(spec.params[j].member);
     const ParamEstimate& p = fit.params[j];
-    if (p.held_off) continue;  // not fitted (fit_effect_term_off)
     if (!(p.stddev > 0) || std::abs(p.value - off) > 2.0 * p.stddev) ++used;
   }
   return std::max<std::size_t>(used, 1);
@@ -84,7 +83,7 @@ std::vector<ParamEstimate> in_spec_order(const EffectSpec& spec, const FitResult
   for (const EffectParamSpec& q : spec.params) {
     const auto it = std::find_if(fit.params.begin(), fit.params.end(),
                                  [&](const ParamEstimate& e) { return e.name == q.name; });
-    out.push_back(it != fit.params.end() ? *it : ParamEstimate{q.name, q.unit, fit.effects.*(q.member), 0.0, false});
+    out.push_back(it != fit.params.end() ? *it : ParamEstimate{q.name, q.unit, fit.effects.*(q.member), 0.0});
   }
   return out;
 }
@@ -271,28 +270,6 @@ FitResult fit_params(const FitProblem& p, const EffectParams& base, const std::v
     res.params.push_back({s.name, s.unit, v[i], std::sqrt(std::max(0.0, cov(i, i)))});
   }
   return res;
-}
-
-FitResult fit_effect_term_off(const FitProblem& p, const EffectParams& base, const EffectSpec& spec,
-                              const std::vector<const EffectParamSpec*>& off_terms) {
-  const EffectParams defaults;
-  EffectParams start = base;
-  std::vector<ParamSpec> free;
-  for (const EffectParamSpec& q : spec.params) {
-    if (std::find(off_terms.begin(), off_terms.end(), &q) != off_terms.end())
-      start.*(q.member) = defaults.*(q.member);
-    else
-      free.push_back(q);
-  }
-  FitResult r = fit_params(p, start, free);
-  std::vector<ParamEstimate> aligned;  // one per parameter of spec, as fit_effect gives them
-  std::size_t k = 0;
-  for (const EffectParamSpec& q : spec.params)
-    aligned.push_back(std::find(off_terms.begin(), off_terms.end(), &q) != off_terms.end()
-                          ? ParamEstimate{q.name, q.unit, defaults.*(q.member), 0.0, true}
-                          : r.params[k++]);
-  r.params = std::move(aligned);
-  return r;
 }
 
 FitResult fit_effect(const FitProblem& p, const EffectParams& base, const EffectSpec& spec) {

@@ -34,7 +34,6 @@ double mean_cost(const FitProblem& p, const EffectParams& e);
 struct ParamEstimate {
   std::string name, unit;
   double value = 0, stddev = 0;
-  bool held_off = false;  // not fitted: held at its off value (fit_effect_term_off)
 };
 
 struct FitResult {
@@ -63,12 +62,6 @@ FitResult fit_place_effect(const FitProblem& p, const EffectParams& base, const 
 
 // One effect (spec) on top of base: start-value grid search, then LM.
 FitResult fit_effect(const FitProblem& p, const EffectParams& base, const EffectSpec& spec);
-
-// One effect without a grid (spec) on top of base with the terms `off_terms` (parameters of spec)
-// held at their off values; LM on the others. params: one per parameter of spec, the held ones
-// at their off value, marked held_off (used_param_count does not count them).
-FitResult fit_effect_term_off(const FitProblem& p, const EffectParams& base, const EffectSpec& spec,
-                              const std::vector<const EffectParamSpec*>& off_terms);
 
 struct SelectionOptions {
   double fit_horizon_s = 0.5;       // multi-step horizon of the fit residuals [s]

@@ -96,7 +96,7 @@ std::string excitation_shortfall(Excitation needs, const ExcitationLevels& x) {
   return "";
 }
 
-const EffectParamSpec* param_at_range_limit(const EffectSpec& spec, const EffectParams& fitted, double margin) {
+std::string range_limit_shortfall(const EffectSpec& spec, const EffectParams& fitted, double margin) {
   const EffectParams defaults;
   for (std::size_t i = 0; i < spec.params.size(); ++i) {
     if (static_cast<int>(i) < grid_param_count(spec.data_grid)) continue;  // searched over the data, not bounded
@@ -109,31 +109,14 @@ const EffectParamSpec* param_at_range_limit(const EffectSpec& spec, const Effect
     const bool lo_physical = lo_closed && p.valid.lo == p.lo, hi_physical = hi_closed && p.valid.hi == p.hi;
     const bool at_lo = v <= p.lo + tol && std::abs(d - p.lo) > tol && !lo_physical;
     const bool at_hi = v >= p.hi - tol && std::abs(d - p.hi) > tol && !hi_physical;
-    if (at_lo || at_hi) return &p;
+    if (at_lo || at_hi) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "%s = %.4g sits at the %s end of its search range [%.4g, %.4g]", p.name, v,
+                    at_lo ? "lower" : "upper", p.lo, p.hi);
+      return buf;
+    }
   }
-  return nullptr;
-}
-
-std::string range_limit_shortfall(const EffectSpec& spec, const EffectParams& fitted, double margin) {
-  const EffectParamSpec* p = param_at_range_limit(spec, fitted, margin);
-  if (!p) return "";
-  const double v = fitted.*(p->member);
-  char buf[200];
-  std::snprintf(buf, sizeof buf, "%s = %.4g sits at the %s end of its search range [%.4g, %.4g]", p->name, v,
-                v <= 0.5 * (p->lo + p->hi) ? "lower" : "upper", p->lo, p->hi);
-  return buf;
-}
-
-const EffectParamSpec* pinnable_at_limit(const EffectSpec& spec, const EffectParams& fitted, double margin,
-                                         const std::vector<const EffectParamSpec*>& pinned) {
-  const EffectParamSpec* p = param_at_range_limit(spec, fitted, margin);
-  if (!p || !p->optional_term) return nullptr;
-  const double off = EffectParams{}.*(p->member);
-  if (!(off > p->lo && off < p->hi)) return nullptr;
-  auto is_pinned = [&](const EffectParamSpec* q) { return std::find(pinned.begin(), pinned.end(), q) != pinned.end(); };
-  for (std::size_t i = static_cast<std::size_t>(grid_param_count(spec.data_grid)); i < spec.params.size(); ++i)
-    if (&spec.params[i] != p && !is_pinned(&spec.params[i])) return p;  // another term stays free
-  return nullptr;
+  return "";
 }
 
 }  // namespace mppi::diagnose

@@ -31,12 +31,5 @@ std::string excitation_shortfall(Excitation needs, const ExcitationLevels& level
 // of an end of its search range that is not its default and not a closed end of its physical
 // range (a share at 1 is an estimate); then which one and where.
 std::string range_limit_shortfall(const EffectSpec& spec, const EffectParams& fitted, double margin = 0.01);
-// The parameter range_limit_shortfall reports, or nullptr.
-const EffectParamSpec* param_at_range_limit(const EffectSpec& spec, const EffectParams& fitted, double margin = 0.01);
-// A parameter at its range limit that may be pinned at its off value instead (an optional term
-// of an effect with another free parameter, whose off value lies inside the search range), or
-// nullptr. `pinned`: terms already pinned (they do not count as free).
-const EffectParamSpec* pinnable_at_limit(const EffectSpec& spec, const EffectParams& fitted, double margin,
-                                         const std::vector<const EffectParamSpec*>& pinned = {});
 
 }  // namespace mppi::diagnose

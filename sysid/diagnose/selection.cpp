@@ -58,7 +58,6 @@ struct CandidateFit {
   bool passes = false;
   bool judged_early = false;  // passed on the earlier fold (the later block could not judge it)
   std::string earlier_fold;   // for the log: the earlier fold's verdict where it was asked
-  std::string term_off;       // an optional term the fit drove to its range end, then held off
 };
 
 struct GreedyResult {
@@ -126,10 +125,6 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
       CandidateFit& c = tried[n];
       c.index = i;
       c.fit = fit_effect(fit, base, spec);
-      if (const EffectParamSpec* term = pinnable_at_limit(spec, c.fit.effects, opt.range_limit_margin)) {
-        c.fit = fit_effect_term_off(fit, base, spec, {term});  // the law without that term
-        c.term_off = std::string(" (") + term->name + " at its range end: fitted without it)";
-      }
       c.val_cost = mean_cost(val, c.fit.effects);
       const double k = static_cast<double>(spec.params.size());
       c.bic = n_eff * std::log(c.fit.cost / base_fit) + k * std::log(n_eff);
@@ -152,9 +147,9 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
     });
     for (const CandidateFit& c : tried) {
       if (log) {
-        std::snprintf(line, sizeof line, "round %d: %-20s validation %+6.1f %%, dBIC %+9.1f%s%s%s", round,
+        std::snprintf(line, sizeof line, "round %d: %-20s validation %+6.1f %%, dBIC %+9.1f%s%s", round,
                       cands[static_cast<std::size_t>(c.index)]->id.c_str(), 100 * (1.0 - c.val_cost / base_val), c.bic,
-                      c.term_off.c_str(), c.earlier_fold.c_str(), c.passes ? "  passes" : "");
+                      c.earlier_fold.c_str(), c.passes ? "  passes" : "");
         log->push_back(line);
       }
       if (c.passes && std::find(out.passed.begin(), out.passed.end(), c.index) == out.passed.end())
@@ -486,8 +481,7 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
   // Joint refit of the named effects on all training segments; an effect whose parameter ends at
   // a bound there is not identified either.
   EffectParams start = only(named, main.effects);
-  std::vector<const EffectParamSpec*> off_terms;  // optional terms held at their off value
-  for (int pass = 0; pass < 4 && !named.empty(); ++pass) {
+  for (int pass = 0; pass < 3 && !named.empty(); ++pass) {
     std::vector<ParamSpec> free;
     std::vector<ParamEstimate> fixed_times;
     for (const auto& id : named) {
@@ -499,32 +493,22 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
             if (c.id == id && !c.params.empty()) fixed_times.back().stddev = c.params[0].stddev;
           continue;
         }
-        if (std::find(off_terms.begin(), off_terms.end(), &s.params[j]) != off_terms.end())
-          start.*(s.params[j].member) = EffectParams{}.*(s.params[j].member);
-        else if (effect_param_active(s.params[j], start))
-          free.push_back(s.params[j]);
+        if (effect_param_active(s.params[j], start)) free.push_back(s.params[j]);
       }
     }
     const FitResult joint = fit_params(all, start, free);
     std::vector<std::string> keep;
-    bool held_off_now = false;
     for (const auto& id : named) {
       const std::string limit = range_limit_shortfall(effect_spec(id), joint.effects, opt.range_limit_margin);
       if (limit.empty()) {
         keep.push_back(id);
-      } else if (const EffectParamSpec* term = pinnable_at_limit(effect_spec(id), joint.effects, opt.range_limit_margin, off_terms)) {
-        // An optional term of the law at its range end: the law without it, refitted.
-        off_terms.push_back(term);
-        held_off_now = true;
-        keep.push_back(id);
-        log.push_back("joint refit: " + id + ": " + limit + "; refitted without it");
       } else {
         for (std::size_t i = 0; i < cands.size(); ++i)
           if (cands[i]->id == id) suspect(static_cast<int>(i), "not identifiable from this recording: " + limit, joint.effects);
         log.push_back("joint refit: " + id + " not identified: " + limit);
       }
     }
-    if (keep.size() == named.size() && !held_off_now) {
+    if (keep.size() == named.size()) {
       sel.final_effects = joint.effects;
       sel.final_params = fixed_times;
       sel.final_params.insert(sel.final_params.end(), joint.params.begin(), joint.params.end());

@@ -15,7 +15,6 @@
 #include "sysid/diagnose/data.hpp"
 #include "sysid/diagnose/effects.hpp"
 #include "sysid/diagnose/fit.hpp"
-#include "sysid/diagnose/identifiability.hpp"
 #include "sysid/diagnose/synth.hpp"
 
 using namespace mppi;
@@ -186,39 +185,4 @@ TEST_CASE("sensor faults written into a clean recording are fitted as sensor fau
       CHECK(effect_spec(c.id).hook == EffectHook::kSensor);
     }
   }
-}
-
-TEST_CASE("an optional term at its range end is held off and the rest of the law refitted", "[diagnose]") {
-  const EffectSpec& rolling = effect_spec("rolling_resistance");
-  const EffectParamSpec* coulomb = &rolling.params[0];
-  const EffectParamSpec* viscous = &rolling.params[1];
-  EffectParams e;
-  e.rolling_force_N = 20.0;
-  e.rolling_viscous_Nspm = viscous->lo;  // driven to the end of its search range
-  CHECK(pinnable_at_limit(rolling, e, 0.01) == viscous);
-  CHECK(pinnable_at_limit(rolling, e, 0.01, {coulomb}) == nullptr);  // nothing else would stay free
-  e.rolling_viscous_Nspm = 2.0;
-  CHECK(pinnable_at_limit(rolling, e, 0.01) == nullptr);  // inside its range: an estimate
-  // A term that is not optional stays a bound (the tyre's peak and stiffness are one curve).
-  EffectParams tyre;
-  tyre.tyre_peak_scale = 3.0;
-  CHECK(param_at_range_limit(effect_spec("tire_saturation"), tyre) == &effect_spec("tire_saturation").params[0]);
-  CHECK(pinnable_at_limit(effect_spec("tire_saturation"), tyre, 0.01) == nullptr);
-
-  // The fit without the viscous term on a recording whose resistance is Coulomb only (oracle:
-  // the truth's F0): F0 recovered, the held term reported at 0 with no spread and not counted.
-  EffectParams truth;
-  truth.rolling_force_N = 25.0;
-  const DiagData d = prepare(synthesize_open_loop(truth, 5, 30.0), "coulomb resistance");
-  const FitProblem p = problem_for(d);
-  const FitResult r = fit_effect_term_off(p, EffectParams{}, rolling, {viscous});
-  REQUIRE(r.params.size() == 2);
-  CHECK(r.params[0].name == std::string("rolling_force_N"));
-  CHECK(r.params[0].value == Approx(25.0).margin(2.5));
-  CHECK(r.params[1].value == 0.0);
-  CHECK(r.params[1].held_off);
-  CHECK_FALSE(r.params[0].held_off);
-  CHECK(r.effects.rolling_viscous_Nspm == 0.0);
-  CHECK(used_param_count(rolling, r) == 1);
-  CHECK(r.cost < mean_cost(p, EffectParams{}));
 }

@@ -318,7 +318,7 @@ TEST_CASE("simplicity counts only the parameters a fit moved off their default",
   using mppi::diagnose::ParamEstimate;
   auto fit_of = [](std::vector<std::pair<double, double>> value_sd) {
     FitResult f;
-    for (const auto& [v, sd] : value_sd) f.params.push_back(ParamEstimate{"p", "", v, sd, false});
+    for (const auto& [v, sd] : value_sd) f.params.push_back(ParamEstimate{"p", "", v, sd});
     return f;
   };
   // rolling_resistance: F0 [N] and b [N s/m], both off at 0.
