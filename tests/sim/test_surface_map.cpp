@@ -107,7 +107,9 @@ TEST_CASE("surface plant: a constant grade changes the acceleration by g sin(the
   const double grade = 0.1, theta = std::atan(grade);
   SurfaceLayer elevation;
   elevation.grade_x = grade;
-  auto hill = std::make_shared<const SurfaceMap>(SurfaceLayer{1.0}, elevation);
+  SurfaceLayer grip;
+  grip.default_value = 1.0;
+  auto hill = std::make_shared<const SurfaceMap>(grip, elevation);
   auto flat = std::make_shared<const SurfaceMap>();
   const SingleTrackParams p;
   const SingleTrackOnSurface on_hill(p, hill), on_flat(p, flat);
@@ -187,7 +189,7 @@ TEST_CASE("surface plant: on a low-grip patch the tyre force is capped at mu_pea
   double x[SingleTrack::kNx] = {0, 0, 0, 6.0, 5.0, 0.5, 0, 6.0 / p.wheel_radius_m, 6.0 / p.wheel_radius_m};
   const double u[2] = {0.5, 0.0};
   const SingleTrackForces on = car.forces(x, u);
-  for (const auto [fx, fy, fz] : {std::tuple{on.front_fx_N, on.front_fy_N, on.front_fz_N},
+  for (const auto& [fx, fy, fz] : {std::tuple{on.front_fx_N, on.front_fy_N, on.front_fz_N},
                                   std::tuple{on.rear_fx_N, on.rear_fy_N, on.rear_fz_N}}) {
     CHECK(std::hypot(fx, fy) <= mu_peak * 0.4 * fz + 1e-9);
     CHECK(std::hypot(fx, fy) >= 0.75 * mu_peak * 0.4 * fz);  // sliding: near the cap
