@@ -19,6 +19,8 @@
 #include "dynamics/single_track.hpp"
 #include <random>
 
+#include <tbb/global_control.h>
+
 using namespace mppi;
 using namespace mppi::diagnose;
 
@@ -365,4 +367,24 @@ TEST_CASE("two patches of one low-grip surface are named as one grip patch with 
   CHECK(e.patch2_radius_m == Approx(3.0).margin(1.0));
   CHECK(e.patch_grip_scale == Approx(0.5).margin(0.15));
   CHECK(r.heldout_rmse_reduction > 0.3);
+}
+
+TEST_CASE("the parallel selection gives the one-thread result", "[diagnose][slow]") {
+  // Oracle: the same diagnosis with oneTBB held to one thread (candidates fitted one at a time).
+  EffectParams truth;
+  parse_effect_assignments("steer_delay_s=0.08", &truth);
+  const DiagData d = prepare(synthesize_open_loop(truth, 41, 20.0), "steering delay, 20 s");
+  const auto family = make_model_family("single-track");
+  const DiagnoseResult parallel = run_diagnosis(d, *family, DiagnoseOptions{});
+  DiagnoseResult serial;
+  {
+    tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+    serial = run_diagnosis(d, *family, DiagnoseOptions{});
+  }
+  CHECK(parallel.selection.log == serial.selection.log);
+  CHECK(parallel.selection.selected == serial.selection.selected);
+  REQUIRE(parallel.selection.final_params.size() == serial.selection.final_params.size());
+  for (std::size_t i = 0; i < serial.selection.final_params.size(); ++i)
+    CHECK(parallel.selection.final_params[i].value == serial.selection.final_params[i].value);
+  CHECK(parallel.heldout_rmse_reduction == serial.heldout_rmse_reduction);
 }
