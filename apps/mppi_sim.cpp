@@ -68,8 +68,8 @@ int main(int argc, char** argv) {
     const mppi::sim::RunSummary summary = mppi::sim::run_closed_loop(config);
 #endif
     if (config.progress)
-      std::fprintf(stderr, "done: %d/%d laps, %d crashes, mean %.2f m/s, max %.2f m/s, optimizer p50 %.2f ms p99 %.2f ms -> %s\n",
-                   summary.laps_completed, config.laps, summary.crashes, summary.mean_speed_mps,
+      std::fprintf(stderr, "done: %d/%d laps, %d crashes, %d stalls, mean %.2f m/s, max %.2f m/s, optimizer p50 %.2f ms p99 %.2f ms -> %s\n",
+                   summary.laps_completed, config.laps, summary.crashes, summary.stalls, summary.mean_speed_mps,
                    summary.max_speed_mps, summary.optimizer_ms_p50, summary.optimizer_ms_p99,
                    config.out_dir.c_str());
     if (cl.print_json) std::cout << mppi::sim::to_json(summary) << std::endl;

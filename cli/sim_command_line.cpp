@@ -28,6 +28,11 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
   app.add_option("--speed", c.target_speed_mps, "target speed [m/s]")->type_name("MPS");
   app.add_option("--laps", c.laps, "laps to drive")->type_name("N");
   app.add_option("--max-time", c.max_time_s, "stop after S simulated seconds (0: from the laps)")->type_name("S");
+  app.add_option("--stall-timeout", c.stall_timeout_s,
+                 "a car with less than 2 m of progress along the track in S seconds is stalled: counted and put "
+                 "back on the track (0: off)")
+      ->type_name("S")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--samples", mppi.num_samples, "MPPI samples per step")->type_name("K");
   app.add_option("--horizon", mppi.horizon, "MPPI time steps")->type_name("T");
   app.add_option("--iterations", mppi.iterations, "MPPI iterations per step")->type_name("N");

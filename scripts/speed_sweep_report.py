@@ -19,6 +19,7 @@ def load_runs(out):
         laps = [t for t in s.get("lap_times_s") or [] if t is not None]
         runs.append({
             "track": track, "target": float(speed), "laps": s["laps_completed"], "crashes": s["crashes"],
+            "stalls": s.get("stalls", 0), "incidents": s["crashes"] + s.get("stalls", 0),
             "mean": s["mean_speed_mps"], "best": min(laps) if laps else math.nan,
             "median": statistics.median(laps) if laps else math.nan,
             "slip_deg": math.degrees(s.get("peak_slip_angle_rad") or 0.0),
@@ -34,14 +35,15 @@ def table(runs):
             "peak body slip [deg] | p95 body slip [deg] | peak lateral accel [m/s^2] |",
             "|---|---|---|---|---|---|---|---|---|---|"]
     for r in runs:
-        rows.append(f"| {r['track']} | {r['target']:g} | {r['laps']} | {r['crashes']} | {r['mean']:.2f} | "
+        crashes = f"{r['crashes']}" + (f" + {r['stalls']} stalled" if r["stalls"] else "")
+        rows.append(f"| {r['track']} | {r['target']:g} | {r['laps']} | {crashes} | {r['mean']:.2f} | "
                     f"{r['best']:.2f} | {r['median']:.2f} | {r['slip_deg']:.1f} | {r['slip95_deg']:.1f} | {r['lat']:.1f} |")
     return "\n".join(rows)
 
 
 def svg(runs, path):
-    """Three panels over target speed: mean speed, crashes, peak body slip; one line per track."""
-    panels = [("mean speed [m/s]", "mean"), ("crashes", "crashes"), ("peak body slip [deg]", "slip_deg")]
+    """Three panels over target speed: mean speed, crashes (stalls included), peak body slip; one line per track."""
+    panels = [("mean speed [m/s]", "mean"), ("crashes + stalls", "incidents"), ("peak body slip [deg]", "slip_deg")]
     w, h, pad = 300, 240, 50
     targets = sorted({r["target"] for r in runs}) or [0.0, 1.0]
     x0, x1 = min(targets), max(targets)

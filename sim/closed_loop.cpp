@@ -173,6 +173,8 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   laps.reset({start.x_m, start.y_m}, 0.0);
   const CrashDetector crash_detector(track);
 
+  if (!(config.stall_timeout_s >= 0.0) || !(config.stall_progress_m >= 0.0))
+    throw Error("stall_timeout_s and stall_progress_m must be >= 0 (0 = no stall check)");
   const double control_dt = config.controller.dt_s;
   const int substeps = std::max(1, static_cast<int>(std::lround(control_dt / config.plant_dt_s)));
   const double max_time = config.max_time_s > 0
@@ -223,6 +225,21 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   if (config.through_chassis) chassis.emplace();
   std::size_t next_target = 0;  // next entry of target_speed_schedule
   double target_speed_mps = config.target_speed_mps;
+  bool motion_enabled = true;
+  // A marshal puts the car back on the centreline nearest to it, at rest, facing along the track.
+  auto marshal_puts_back = [&](const VehicleState& s) {
+    const ClosestPoint c = closest_point(track.centreline(), true, {s.x_m, s.y_m});
+    const Vec2 a = track.centreline()[c.segment];
+    const Vec2 b = track.centreline()[(c.segment + 1) % track.centreline().size()];
+    VehicleState respawn;
+    respawn.x_m = static_cast<float>(c.point.x);
+    respawn.y_m = static_cast<float>(c.point.y);
+    respawn.yaw_rad = static_cast<float>(std::atan2(b.y - a.y, b.x - a.x));
+    plant.reset(respawn);
+    controller->reset();
+  };
+  // Stall watch: the progress last reached and when (reset while the car is not asked to drive).
+  double stall_ref_progress_m = laps.progress_m(), stall_ref_t = 0.0;
   if (config.observer) config.observer->on_start(setup.predict);
   while (t < max_time && laps.laps_completed() < config.laps) {
     if (config.observer) {
@@ -231,7 +248,10 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
       std::string why;
       if (r.target_speed_mps && controller->set_cost_param("target_speed_mps", *r.target_speed_mps, &why))
         target_speed_mps = *r.target_speed_mps;
-      if (r.motion_enabled && chassis) chassis->set_motion_enabled(*r.motion_enabled);
+      if (r.motion_enabled && chassis) {
+        chassis->set_motion_enabled(*r.motion_enabled);
+        motion_enabled = *r.motion_enabled;
+      }
     }
     const auto& schedule = config.target_speed_schedule;
     if (next_target < schedule.size() && t + 1e-9 >= schedule[next_target].first) {
@@ -273,20 +293,27 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
         crash_points.emplace_back(static_cast<float>(crash.x_m), static_cast<float>(crash.y_m));
         if (config.progress)
           std::fprintf(stderr, "  crash at t = %.2f s: %s\n", t, crash.reason.c_str());
-        // A marshal puts the car back on the centreline, at rest, facing along the track.
-        const ClosestPoint c = closest_point(track.centreline(), true, {s.x_m, s.y_m});
-        const Vec2 a = track.centreline()[c.segment];
-        const Vec2 b = track.centreline()[(c.segment + 1) % track.centreline().size()];
-        VehicleState respawn;
-        respawn.x_m = static_cast<float>(c.point.x);
-        respawn.y_m = static_cast<float>(c.point.y);
-        respawn.yaw_rad = static_cast<float>(std::atan2(b.y - a.y, b.x - a.x));
-        plant.reset(respawn);
-        controller->reset();
+        marshal_puts_back(s);
+        stall_ref_progress_m = laps.progress_m();
+        stall_ref_t = t;
         in_contact = false;
         break;  // new control step from the respawned state
       }
       in_contact = crash.crashed;
+    }
+    const bool asked_to_drive = motion_enabled && target_speed_mps >= 1.0;
+    if (!asked_to_drive || laps.progress_m() >= stall_ref_progress_m + config.stall_progress_m) {
+      stall_ref_progress_m = laps.progress_m();
+      stall_ref_t = t;
+    } else if (config.stall_timeout_s > 0.0 && t - stall_ref_t >= config.stall_timeout_s) {
+      ++summary.stalls;
+      summary.stall_times_s.push_back(t);
+      if (config.progress)
+        std::fprintf(stderr, "  stalled at t = %.2f s: less than %.1f m of progress in %.1f s; put back on the track\n",
+                     t, config.stall_progress_m, config.stall_timeout_s);
+      marshal_puts_back(plant.vehicle_state());
+      stall_ref_progress_m = laps.progress_m();
+      stall_ref_t = t;
     }
     const VehicleState s = plant.vehicle_state();
     const double speed = std::hypot(s.vx_mps, s.vy_mps);

@@ -3,7 +3,8 @@
 // plant model) around a built-in track. The plant is integrated at 500 Hz behind rate-limited
 // actuators, the controller runs at 50 Hz on the plant's exact state; laps are counted by
 // progress along the centreline and a crash is a barrier contact or leaving the track (the
-// car is then put back on the centreline at rest, and the run goes on). Seeded, deterministic.
+// car is then put back on the centreline at rest, and the run goes on; so is a car that stalls,
+// making no progress along the track). Seeded, deterministic.
 #include <functional>
 #include <string>
 #include <utility>
@@ -34,6 +35,11 @@ struct ClosedLoopConfig {
   std::vector<std::pair<double, double>> target_speed_schedule;
   int laps = 5;                           // stop after this many laps
   double max_time_s = 0.0;                // stop after this much simulated time; 0 = from laps
+  // A car that makes less than stall_progress_m of progress along the centreline in
+  // stall_timeout_s, while asked for at least 1 m/s with motion enabled, is stalled (spun and
+  // stuck, or not moving): counted in RunSummary::stalls and put back like a crash. 0 = off.
+  double stall_timeout_s = 10.0;
+  double stall_progress_m = 2.0;
   ControllerOptions controller;           // K, T, seed, threads, noise, lambda, ...
   BackendChoice backend = BackendChoice::kCpu;  // rollout backend: cpu | vulkan | auto (mppi/make_controller.hpp)
   BackendReport* backend_report = nullptr;  // if set, receives the backend that ran and why

@@ -33,6 +33,9 @@ std::string to_json(const RunSummary& s) {
   for (double t : s.lap_times_s) j["lap_times_s"].push_back(number(t));
   j["crashes"] = s.crashes;
   j["crash_reasons"] = s.crash_reasons;
+  j["stalls"] = s.stalls;
+  j["stall_times_s"] = nlohmann::ordered_json::array();
+  for (double t : s.stall_times_s) j["stall_times_s"].push_back(number(t));
   j["mean_speed_mps"] = number(s.mean_speed_mps);
   j["max_speed_mps"] = number(s.max_speed_mps);
   j["peak_slip_angle_rad"] = number(s.peak_slip_angle_rad);

@@ -28,6 +28,10 @@ struct RunSummary {
   std::vector<double> lap_times_s;
   int crashes = 0;
   std::vector<std::string> crash_reasons;
+  // Stalls: the car made less than ClosedLoopConfig::stall_progress_m of progress along the track
+  // in stall_timeout_s while asked to drive (spun and stuck, or not moving): put back like a crash.
+  int stalls = 0;
+  std::vector<double> stall_times_s;  // simulated time of each
   double mean_speed_mps = 0.0;
   double max_speed_mps = 0.0;
   // Body slip angle atan2(v_y, v_x) and lateral acceleration dv_y/dt + v_x r, at the control

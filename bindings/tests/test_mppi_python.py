@@ -56,6 +56,7 @@ def test_closed_loop_matches_cpp_program(cpp_run, tmp_path):
     assert py.finished and cpp["finished"]
     assert py.crashes == cpp["crashes"]
     assert py.crash_reasons == cpp["crash_reasons"]
+    assert py.stalls == cpp["stalls"] == 0
     assert py.lap_times_s == cpp["lap_times_s"]  # same seed: the same run, to the last bit
     assert py.sim_time_s == cpp["sim_time_s"]
     assert py.mean_speed_mps == cpp["mean_speed_mps"]

@@ -98,3 +98,58 @@ TEST_CASE("bad closed-loop settings are rejected clearly", "[sim][closed_loop]")
   config.track = "monza";
   CHECK_THROWS_WITH(mppi::sim::run_closed_loop(config), Catch::Contains("gazebo"));
 }
+
+namespace {
+// Pulls the operator's runstop before the first step and leaves it pulled.
+class RunstopHeld : public mppi::sim::StepObserver {
+ public:
+  void on_start(mppi::sim::PathPredictor) override {}
+  void after_step(const mppi::sim::StepView&) override {}
+  mppi::sim::OperatorRequests poll_requests(double) override {
+    mppi::sim::OperatorRequests r;
+    r.motion_enabled = false;
+    return r;
+  }
+};
+}  // namespace
+
+TEST_CASE("a car that cannot move is found stalled and put back, and is not counted as a crash",
+          "[sim][closed_loop]") {
+  // No drive at all (throttle held at or below 0): the car stays where it starts, so it makes
+  // no progress and the stall watch (10 s, 2 m) must fire at t = 10 s and again at 20 s.
+  auto config = short_run("single-track");
+  config.actuators.throttle_max = 0.f;
+  config.max_time_s = 25.0;
+  const auto summary = mppi::sim::run_closed_loop(config);
+  CHECK(summary.laps_completed == 0);
+  CHECK_FALSE(summary.finished);
+  CHECK(summary.crashes == 0);
+  REQUIRE(summary.stalls == 2);
+  REQUIRE(summary.stall_times_s.size() == 2);
+  CHECK(summary.stall_times_s[0] == Approx(10.0).margin(0.03));
+  CHECK(summary.stall_times_s[1] == Approx(20.0).margin(0.05));
+  CHECK(mppi::sim::to_json(summary).find("\"stalls\": 2") != std::string::npos);
+
+  // Off: no stall is counted.
+  config.stall_timeout_s = 0.0;
+  CHECK(mppi::sim::run_closed_loop(config).stalls == 0);
+}
+
+TEST_CASE("a car held by the operator's runstop is not stalled", "[sim][closed_loop]") {
+  auto config = short_run("single-track");
+  config.max_time_s = 15.0;
+  RunstopHeld runstop;
+  config.observer = &runstop;
+  const auto summary = mppi::sim::run_closed_loop(config);
+  CHECK(summary.max_speed_mps < 0.1);  // the runstop held it
+  CHECK(summary.stalls == 0);
+  CHECK(summary.crashes == 0);
+}
+
+TEST_CASE("a lap at speed is no stall", "[sim][closed_loop]") {
+  auto config = short_run("single-track");
+  config.stall_timeout_s = 3.0;  // a lap of ~15 s makes 2 m in far less than 3 s once rolling
+  const auto summary = mppi::sim::run_closed_loop(config);
+  CHECK(summary.laps_completed == 1);
+  CHECK(summary.stalls == 0);
+}

@@ -48,6 +48,8 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.lap_times_s = {12.5, 11.75};
   s.crashes = 1;
   s.crash_reasons = {"hit the outer barrier at (1.00, 2.00)"};
+  s.stalls = 1;
+  s.stall_times_s = {31.5};
   s.mean_speed_mps = 5.5;
   s.max_speed_mps = 7.25;
   s.optimizer_ms_p50 = 1.5;
@@ -57,7 +59,7 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.p95_slip_angle_rad = 0.125;
   s.peak_lateral_accel_mps2 = 6.5;
   const auto j = nlohmann::json::parse(to_json(s));
-  CHECK(j.size() == 24);
+  CHECK(j.size() == 26);
   CHECK(j.at("track") == "gazebo");
   CHECK(j.at("model") == "nn_autorally");
   CHECK(j.at("plant") == "single_track");
@@ -71,6 +73,8 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   CHECK(j.at("lap_times_s") == nlohmann::json::array({12.5, 11.75}));
   CHECK(j.at("crashes") == 1);
   CHECK(j.at("crash_reasons")[0] == "hit the outer barrier at (1.00, 2.00)");
+  CHECK(j.at("stalls") == 1);
+  CHECK(j.at("stall_times_s") == nlohmann::json::array({31.5}));
   CHECK(j.at("mean_speed_mps") == 5.5);
   CHECK(j.at("max_speed_mps") == 7.25);
   CHECK(j.at("optimizer_ms_p50") == 1.5);
