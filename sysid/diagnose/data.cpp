@@ -45,16 +45,43 @@ DiagData prepare(const sim::Recording& rec, const std::string& source, std::size
   d.flags = screen_columns(d.t, columns, screen);
   for (ScreenFlag& f : d.flags) f.file = source;
   const std::vector<char> screened = screened_rows(n, d.flags, screen.guard_rows);
-  // Pieces: cut at NaN rows, screened rows, gaps > 3 median intervals, and position jumps no
-  // car makes.
+  // Pieces: cut at NaN rows, screened rows, gaps > 3 median intervals, position jumps no car
+  // makes, and displacements that the measured velocities do not account for (a respawn or a
+  // teleport: at a low sample rate a jump of a track's half width is within what a car covers
+  // between two rows, but not in that direction or at that speed).
+  auto unexplained_displacement_m = [&](std::size_t k) {
+    const double dt = d.t[k] - d.t[k - 1];
+    const double c0 = std::cos(d.yaw[k - 1]), s0 = std::sin(d.yaw[k - 1]);
+    const double c1 = std::cos(d.yaw[k]), s1 = std::sin(d.yaw[k]);
+    const double px = 0.5 * dt * (c0 * d.vx[k - 1] - s0 * d.vy[k - 1] + c1 * d.vx[k] - s1 * d.vy[k]);
+    const double py = 0.5 * dt * (s0 * d.vx[k - 1] + c0 * d.vy[k - 1] + s1 * d.vx[k] + c1 * d.vy[k]);
+    return std::hypot(d.x[k] - d.x[k - 1] - px, d.y[k] - d.y[k - 1] - py);
+  };
+  auto row_ok = [&](std::size_t k) {
+    const double vals[] = {d.t[k], d.x[k], d.y[k], d.yaw[k], d.vx[k], d.vy[k], d.r[k], d.steer[k], d.throttle[k]};
+    bool ok = !screened[k];
+    for (double v : vals) ok = ok && std::isfinite(v);
+    return ok;
+  };
+  // The threshold (also the slack of the position-jump rule) scales with the recording's own
+  // typical disagreement (position noise, a fused estimate's lag), so that noisy positions do
+  // not cut everywhere.
+  double teleport_m = 0.25;
+  {
+    std::vector<double> e;
+    for (std::size_t k = 1; k < n; ++k)
+      if (row_ok(k) && row_ok(k - 1) && d.t[k] - d.t[k - 1] <= 3 * d.dt_s) e.push_back(unexplained_displacement_m(k));
+    if (!e.empty()) {
+      std::nth_element(e.begin(), e.begin() + static_cast<std::ptrdiff_t>(e.size() / 2), e.end());
+      teleport_m = std::max(teleport_m, 10.0 * e[e.size() / 2]);
+    }
+  }
   d.piece.assign(n, -1);
   int id = -1;
   bool open = false;
   std::size_t usable = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    const double vals[] = {d.t[k], d.x[k], d.y[k], d.yaw[k], d.vx[k], d.vy[k], d.r[k], d.steer[k], d.throttle[k]};
-    bool ok = !screened[k];
-    for (double v : vals) ok = ok && std::isfinite(v);
+    const bool ok = row_ok(k);
     if (screened[k]) ++d.screened_rows;
     if (!ok) {
       open = false;
@@ -64,7 +91,7 @@ DiagData prepare(const sim::Recording& rec, const std::string& source, std::size
       const double gap = d.t[k] - d.t[k - 1];
       const double jump = std::hypot(d.x[k] - d.x[k - 1], d.y[k] - d.y[k - 1]);
       const double vmax = std::max(std::abs(d.vx[k]), std::abs(d.vx[k - 1])) + 2.0;
-      if (gap > 3 * d.dt_s || jump > 3 * vmax * gap + 0.2) open = false;
+      if (gap > 3 * d.dt_s || jump > 3 * vmax * gap + teleport_m || unexplained_displacement_m(k) > teleport_m) open = false;
     }
     if (!open) {
       ++id;

@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
+#include <algorithm>
+#include <random>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -143,4 +145,55 @@ TEST_CASE("the diagnose report lists the screened values", "[diagnose][screen]")
   CHECK_THAT(md, Catch::Contains("Screened values") && Catch::Contains("| 300 |") && Catch::Contains("| vy |"));
   std::filesystem::remove(csv);
   std::filesystem::remove_all(out);
+}
+
+namespace {
+// A car driving straight along x at 5 m/s, sampled at 20 Hz; from row `respawn` on it stands
+// still 1 m to the side and 0.3 m back (a marshal put it back on the track). Position noise of
+// sigma `position_noise_m` on x and y (a GPS-like fix) when given; velocities exact.
+sim::Recording straight_drive(std::size_t rows, std::size_t respawn, double position_noise_m, unsigned seed) {
+  sim::Recording rec;
+  rec.columns = {"t", "x", "y", "yaw", "vx", "vy", "yaw_rate", "steer", "throttle"};
+  rec.data.assign(rec.columns.size(), std::vector<double>(rows, 0.0));
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, position_noise_m);
+  const double dt = 0.05, v = 5.0;
+  double x_at_respawn = 0.0;
+  for (std::size_t k = 0; k < rows; ++k) {
+    const bool moving = k < respawn;
+    if (k == respawn) x_at_respawn = v * dt * static_cast<double>(k - 1) - 0.3;
+    rec.data[0][k] = dt * static_cast<double>(k);
+    rec.data[1][k] = (moving ? v * dt * static_cast<double>(k) : x_at_respawn) + (position_noise_m > 0 ? noise(rng) : 0.0);
+    rec.data[2][k] = (moving ? 0.0 : 1.0) + (position_noise_m > 0 ? noise(rng) : 0.0);
+    rec.data[4][k] = moving ? v : 0.0;
+    rec.data[8][k] = moving ? 0.3 : 0.0;
+  }
+  return rec;
+}
+
+int pieces(const DiagData& d) { return *std::max_element(d.piece.begin(), d.piece.end()) + 1; }
+}  // namespace
+
+TEST_CASE("a respawn is cut out at a low sample rate, where its jump is within a row's travel",
+          "[diagnose][screen]") {
+  // At 20 Hz the 1.04 m jump is less than the 1.25 m that "3 (v + 2) dt + 0.2" allows for any
+  // displacement, but not in the direction or at the speed the velocities say.
+  const DiagData d = prepare(straight_drive(400, 200, 0.0, 1), "respawn", 100);
+  CHECK(pieces(d) == 2);
+  CHECK(d.piece[199] == 0);
+  CHECK(d.piece[200] == 1);
+  CHECK(d.screened_rows == 0);  // a respawn is cut, not reported as a sensor fault
+}
+
+TEST_CASE("noisy positions (a GPS fix) are not cut into pieces", "[diagnose][screen]") {
+  // 0.2 m of noise per axis: the displacements disagree with the velocities by about 0.3 m
+  // every row, which sets the recording's own scale; no row of 2000 is a respawn.
+  const DiagData d = prepare(straight_drive(2000, 2000, 0.2, 7), "gps", 100);
+  CHECK(pieces(d) == 1);
+  // The same noise with a respawn of 4 m: cut there.
+  sim::Recording rec = straight_drive(2000, 1000, 0.2, 7);
+  for (std::size_t k = 1000; k < 2000; ++k) rec.data[2][k] += 3.0;
+  const DiagData r = prepare(rec, "gps respawn", 100);
+  CHECK(pieces(r) == 2);
+  CHECK(r.piece[999] != r.piece[1000]);
 }
