@@ -24,12 +24,13 @@ const char* kEvidenceUsage = R"(usage:
   mppi-fit diagnose synth --generator independent --out FILE.csv [--effect key=value,...] [--seed N]
         [--duration S] [--track gazebo|marietta|ccrf] [--direction ccw|cw] [--driver pursuit|human]
         [--speed-range MIN:MAX] [--noise-scale F] [--glitch-rate P] [--drop-rate P] [--vehicle FILE.yaml]
+        [--rate HZ]  (the driver's and the log's rate, default 50)
         writes FILE.csv, FILE.clean.csv (noise-free), FILE.truth.json (effects, sizes, table ids);
         the car has the constants of --vehicle (default data/config/autorally_single_track.yaml):
         diagnose against the same file (mppi-fit diagnose --params FILE.yaml)
   mppi-fit diagnose sweep --generator independent [--reduced] [--seeds N] [--sizes small,large]
         [--effects A,B] [--pairs N] [--clean N] [--duration S] [--jobs N] [--out DIR] [--md FILE]
-        [--vehicle FILE.yaml]  (the car's constants, also the diagnosis' nominal)
+        [--vehicle FILE.yaml]  (the car's constants, also the diagnosis' nominal) [--rate HZ]
         [--summarize DIR]  (only the table, from DIR/runs.jsonl of a sweep, finished or not)
         (full grid: 5 seeds, every effect at both sizes, 8 pairs, 20 effect-free; --reduced: 1 seed,
         3 pairs, 4 effect-free). Writes DIR/runs.jsonl, DIR/evidence_sweep.md, DIR/evidence_sweep.json.
@@ -93,6 +94,7 @@ int evidence_synth(int argc, char** argv) {
     else if (f == "--glitch-rate") o.noise.glitch_rate = number(f, value());
     else if (f == "--drop-rate") o.noise.drop_rate = number(f, value());
     else if (f == "--vehicle") o.vehicle_yaml = value();
+    else if (f == "--rate") o.log_dt_s = evidence::log_interval_s(number(f, value()), o.physics_dt_s);
     else if (f == "--help" || f == "-h") {
       std::fputs(usage().c_str(), stdout);
       return 0;
@@ -131,7 +133,10 @@ int evidence_sweep(int argc, char** argv) {
     else if (f == "--jobs") jobs = std::max(1, static_cast<int>(number(f, value())));
     else if (f == "--out") out = value();
     else if (f == "--vehicle") vehicle = value();
-    else if (f == "--md") md_copy = value();
+    else if (f == "--rate") {
+      grid.rate_hz = number(f, value());
+      evidence::log_interval_s(grid.rate_hz);  // checked before the first run
+    } else if (f == "--md") md_copy = value();
     else if (f == "--summarize") summarize = value();
     else if (f == "--help" || f == "-h") {
       std::fputs(usage().c_str(), stdout);
@@ -147,7 +152,11 @@ int evidence_sweep(int argc, char** argv) {
     if (!md_copy.empty()) std::ofstream(md_copy) << md;
     return 0;
   }
-  if (reduced) grid = diagnose::reduced_evidence_grid();
+  if (reduced) {
+    const double rate_hz = grid.rate_hz;
+    grid = diagnose::reduced_evidence_grid();
+    grid.rate_hz = rate_hz;
+  }
   if (seeds >= 0) grid.seeds = seeds;
   if (pairs >= 0) grid.pairs = pairs;
   if (clean >= 0) grid.clean = clean;
@@ -166,7 +175,7 @@ int evidence_sweep(int argc, char** argv) {
     for (std::size_t k = next++; k < cases.size(); k = next++) {
       diagnose::DiagnoseOptions o;
       o.plots = false;
-      runs[k] = diagnose::run_evidence_case(cases[k], out, grid.duration_s, o, grid.vehicle_yaml);
+      runs[k] = diagnose::run_evidence_case(cases[k], out, grid.duration_s, o, grid.vehicle_yaml, grid.rate_hz);
       const auto& r = runs[k];
       std::lock_guard<std::mutex> lock(io);
       std::string named;

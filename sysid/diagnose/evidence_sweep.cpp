@@ -98,13 +98,14 @@ std::vector<EvidenceCase> evidence_cases(const EvidenceGrid& g) {
 }
 
 EvidenceRun run_evidence_case(const EvidenceCase& c, const std::string& dir, double duration_s,
-                              const DiagnoseOptions& o, const std::string& vehicle_yaml) {
+                              const DiagnoseOptions& o, const std::string& vehicle_yaml, double rate_hz) {
   EvidenceRun run;
   run.c = c;
   try {
     evidence::EvidenceOptions eo;
     eo.seed = static_cast<std::uint64_t>(c.seed);
     eo.duration_s = duration_s;
+    eo.log_dt_s = evidence::log_interval_s(rate_hz);
     eo.vehicle_yaml = vehicle_yaml;
     eo.truth_names = evidence::set_truth_effects(c.assignments, &eo.truth);
     const std::string csv = dir + "/" + c.label() + ".csv";

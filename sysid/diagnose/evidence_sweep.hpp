@@ -41,6 +41,7 @@ struct EvidenceGrid {
   int clean = 20;                    // effect-free recordings
   double duration_s = 60;
   std::string vehicle_yaml;          // the car's constants and the diagnosis' nominal (empty: the generator's default)
+  double rate_hz = 50;               // the driver's and the log's rate
 };
 // The reduced grid: 1 seed, both sizes, 3 pairs, 4 effect-free recordings.
 EvidenceGrid reduced_evidence_grid();
@@ -49,7 +50,7 @@ std::vector<EvidenceCase> evidence_cases(const EvidenceGrid& g);
 // Generates (unless the recording exists) and diagnoses one case against the vehicle file the
 // car was built from; never throws (error set).
 EvidenceRun run_evidence_case(const EvidenceCase& c, const std::string& dir, double duration_s,
-                              const DiagnoseOptions& o, const std::string& vehicle_yaml = "");
+                              const DiagnoseOptions& o, const std::string& vehicle_yaml = "", double rate_hz = 50);
 
 std::string evidence_run_json(const EvidenceRun& r);
 // The runs of a runs.jsonl (one evidence_run_json line each; a sweep cut short is summarised

@@ -9,14 +9,17 @@
 
 namespace mppi::evidence {
 
-constexpr double kDriverPeriod_s = 0.02;  // the drivers decide at 50 Hz
+constexpr double kReactionDelay_s = 0.12;  // the human's
+constexpr double kHandKeepPer20ms = 0.65;   // the human's hand: share of its position kept per 20 ms
+constexpr double kPedalRate_per_s = 2.0;    // the human's foot: throttle change per second
 
 Driver::Driver(const std::string& kind, const sim::Track& track, std::uint64_t seed, double speed_min_mps,
-               double speed_max_mps, double wheelbase_m, double max_steer_rad)
-    : kind_(kind), track_(track), rng_(seed * 2654435761ULL + 97), speed_min_(speed_min_mps),
+               double speed_max_mps, double wheelbase_m, double max_steer_rad, double period_s)
+    : kind_(kind), period_s_(period_s), track_(track), rng_(seed * 2654435761ULL + 97), speed_min_(speed_min_mps),
       speed_max_(speed_max_mps), wheelbase_(wheelbase_m), max_steer_(max_steer_rad) {
   if (kind != "pursuit" && kind != "human") throw Error("evidence driver '" + kind + "': valid are pursuit, human");
   if (!(speed_min_mps > 0 && speed_max_mps >= speed_min_mps)) throw Error("evidence driver: need 0 < speed min <= max");
+  if (!(period_s > 0 && period_s <= 0.5)) throw Error("evidence driver: need a period in (0, 0.5] s");
 }
 
 void Driver::respawned() {
@@ -105,10 +108,11 @@ std::pair<double, double> Driver::command(const DriverView& v) {
     steer += dither_ + 0.06 * std::sin(2 * std::numbers::pi * 1.3 * v.t_s);
   } else {  // a human: reacts 0.12 s late, moves the hand smoothly, small tremor
     steer_memory_.push_back(steer);
-    const std::size_t late = 6;
+    const std::size_t late = static_cast<std::size_t>(std::lround(kReactionDelay_s / period_s_));
     const double seen = steer_memory_.size() > late ? steer_memory_[steer_memory_.size() - 1 - late] : steer;
-    if (steer_memory_.size() > 64) steer_memory_.erase(steer_memory_.begin(), steer_memory_.begin() + 32);
-    hand_ += 0.35 * (seen - hand_);
+    if (steer_memory_.size() > 2 * late + 64)
+      steer_memory_.erase(steer_memory_.begin(), steer_memory_.end() - static_cast<std::ptrdiff_t>(late + 32));
+    hand_ += (1.0 - std::pow(kHandKeepPer20ms, period_s_ / 0.02)) * (seen - hand_);
     std::normal_distribution<double> tremor(0, 0.02);
     steer = hand_ + tremor(rng_);
   }
@@ -117,7 +121,7 @@ std::pair<double, double> Driver::command(const DriverView& v) {
   // Speed: feed-forward for the car's steady speed, PI on the error, brakes when too fast.
   const double vt = target_speed(v, s);
   const double err = vt - v.speed_mps;
-  integral_ = std::clamp(integral_ + err * kDriverPeriod_s, -3.0, 3.0);
+  integral_ = std::clamp(integral_ + err * period_s_, -3.0, 3.0);
   double throttle = std::clamp(0.05 * vt + 0.25 * err + 0.05 * integral_, -0.9, 0.9);
   if (kind_ == "human") {
     // A human's foot: it squeezes the throttle at low speed (no full throttle from rest), lifts
@@ -127,7 +131,7 @@ std::pair<double, double> Driver::command(const DriverView& v) {
     const double bend_radps = v.speed_mps * curvature_ahead(s, 2.0);
     const double excess_radps = std::abs(v.yaw_rate_radps) - (1.15 * bend_radps + 0.15);
     if (excess_radps > 0) throttle = std::min(throttle, std::max(0.0, 0.3 - 0.6 * excess_radps));
-    const double step = 2.0 * kDriverPeriod_s;
+    const double step = kPedalRate_per_s * period_s_;
     foot_ = std::clamp(throttle, foot_ - step, foot_ + step);
     throttle = foot_;
   }

@@ -22,8 +22,11 @@ struct DriverView {
 class Driver {
  public:
   // kind: "pursuit" or "human". Throws mppi::Error for another kind.
+  // period_s: how often command() is called (the driver's and the log's rate); the integrator,
+  // the human's reaction delay, hand smoothing and pedal rate are in seconds, so the same driver
+  // at another rate.
   Driver(const std::string& kind, const sim::Track& track, std::uint64_t seed, double speed_min_mps,
-         double speed_max_mps, double wheelbase_m, double max_steer_rad);
+         double speed_max_mps, double wheelbase_m, double max_steer_rad, double period_s = 0.02);
   // (steer, throttle) in [-1, 1].
   std::pair<double, double> command(const DriverView& v);
   void respawned();  // after a crash: forget the integrator and the hint
@@ -34,6 +37,7 @@ class Driver {
   double curvature_ahead(double arc_m, double distance_m) const;
 
   std::string kind_;
+  double period_s_;
   const sim::Track& track_;
   std::mt19937_64 rng_;
   double speed_min_, speed_max_, wheelbase_, max_steer_;

@@ -84,6 +84,15 @@ struct Sample {
 std::string clean_path_of(const std::string& csv_path) { return stem_of(csv_path) + ".clean.csv"; }
 std::string truth_path_of(const std::string& csv_path) { return stem_of(csv_path) + ".truth.json"; }
 
+double log_interval_s(double rate_hz, double physics_dt_s) {
+  if (!(rate_hz >= 5 && rate_hz <= 500)) throw Error("evidence: the log rate must be in [5, 500] Hz, got " + std::to_string(rate_hz));
+  const double steps = 1.0 / (rate_hz * physics_dt_s);
+  if (std::abs(steps - std::round(steps)) > 1e-9 * steps)
+    throw Error("evidence: the log rate " + std::to_string(rate_hz) + " Hz is not a whole number of " +
+                std::to_string(physics_dt_s) + " s physics steps (e.g. 10, 20, 25, 50, 100, 200 Hz)");
+  return std::round(steps) * physics_dt_s;
+}
+
 EvidenceResult generate_evidence(const EvidenceOptions& o, const std::string& csv_path) {
   if (!(o.duration_s > 1 && o.physics_dt_s > 0 && o.log_dt_s >= o.physics_dt_s))
     throw Error("evidence: need duration > 1 s and 0 < physics step <= log step");
@@ -101,7 +110,8 @@ EvidenceResult generate_evidence(const EvidenceOptions& o, const std::string& cs
   const sim::CrashDetector crashes(track);
   res.vehicle_yaml = o.vehicle_yaml.empty() ? sim::data_file("config/autorally_single_track.yaml") : o.vehicle_yaml;
   const CarConstants car = read_car_constants(res.vehicle_yaml);
-  Driver driver(res.driver, track, o.seed, o.speed_min_mps, o.speed_max_mps, car.lf_m + car.lr_m, car.max_steer_rad);
+  Driver driver(res.driver, track, o.seed, o.speed_min_mps, o.speed_max_mps, car.lf_m + car.lr_m, car.max_steer_rad,
+                o.log_dt_s);
   ActuatorChain chain(o.truth, car);
 
   auto at_rest_on_centreline = [&](double x, double y) {

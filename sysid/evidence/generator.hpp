@@ -38,8 +38,12 @@ struct EvidenceOptions {
   double speed_min_mps = 3, speed_max_mps = 8;
   std::string vehicle_yaml;  // vehicle constants; empty = data/config/autorally_single_track.yaml
   EvidenceNoise noise;
-  double physics_dt_s = 0.001, log_dt_s = 0.02;
+  double physics_dt_s = 0.001, log_dt_s = 0.02;  // the driver acts and the log writes every log_dt_s
 };
+
+// The log (and driver) interval for a rate in Hz: a whole number of physics steps, between 5 and
+// 500 Hz; throws mppi::Error otherwise.
+double log_interval_s(double rate_hz, double physics_dt_s = 0.001);
 
 struct EvidenceResult {
   std::string csv, clean_csv, truth_json, track, direction, driver;
