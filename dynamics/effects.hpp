@@ -161,6 +161,10 @@ struct EffectSpec {
   std::vector<double> grid;     // start values searched for params[0] (empty: its default)
   DataGrid data_grid = DataGrid::kNone;  // leading params searched over the data (not LM-fitted)
   Excitation needs = Excitation::kAny;
+  // The actuator whose dynamics this is ("steer", "throttle"; empty: none). A delay, a lag, a rate
+  // limit and a play of one actuator all hold back its response, and a recording with smooth
+  // commands may not tell these forms apart.
+  std::string dynamics_of = {};
 };
 
 // Every effect, in a fixed order.
@@ -177,14 +181,14 @@ inline const std::vector<EffectSpec>& effect_table() {
        {{"rolling_force_N", &E::rolling_force_N, "N", kAny, -10.0, 60.0, 2.0},
         {"rolling_viscous_Nspm", &E::rolling_viscous_Nspm, "N s/m", kAny, -5.0, 30.0, 1.0}}, {}, DataGrid::kNone, X::kSpeedRange},
       {"steer_delay", "pure delay of the steering command", H::kActuator,
-       {{"steer_delay_s", &E::steer_delay_s, "s", kNonNeg, 0.0, 0.4, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25}, DataGrid::kNone, X::kSteer},
+       {{"steer_delay_s", &E::steer_delay_s, "s", kNonNeg, 0.0, 0.4, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25}, DataGrid::kNone, X::kSteer, "steer"},
       {"throttle_delay", "pure delay of the throttle command", H::kActuator,
        {{"throttle_delay_s", &E::throttle_delay_s, "s", kNonNeg, 0.0, 0.4, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25},
-       DataGrid::kNone, X::kThrottle},
+       DataGrid::kNone, X::kThrottle, "throttle"},
       {"steer_lag", "first-order steering actuator", H::kActuator,
-       {{"steer_lag_s", &E::steer_lag_s, "s", kNonNeg, 0.0, 0.6, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25}, DataGrid::kNone, X::kSteer},
+       {{"steer_lag_s", &E::steer_lag_s, "s", kNonNeg, 0.0, 0.6, 0.05}}, {0.03, 0.06, 0.1, 0.15, 0.25}, DataGrid::kNone, X::kSteer, "steer"},
       {"throttle_lag", "first-order throttle / motor response", H::kActuator,
-       {{"throttle_lag_s", &E::throttle_lag_s, "s", kNonNeg, 0.0, 1.0, 0.05}}, {0.03, 0.06, 0.1, 0.2, 0.4}, DataGrid::kNone, X::kThrottle},
+       {{"throttle_lag_s", &E::throttle_lag_s, "s", kNonNeg, 0.0, 1.0, 0.05}}, {0.03, 0.06, 0.1, 0.2, 0.4}, DataGrid::kNone, X::kThrottle, "throttle"},
       {"steer_offset", "steering bias (trim)", H::kActuator,
        {{"steer_offset", &E::steer_offset, "1 (normalised steer)", kAny, -0.4, 0.4, 0.02}}, {}, DataGrid::kNone, X::kSteer},
       {"steer_gain", "steering scale (servo / linkage gain)", H::kActuator,
@@ -229,13 +233,13 @@ inline const std::vector<EffectSpec>& effect_table() {
        {{"steer_asymmetry", &E::steer_asymmetry, "1", open(-0.9, 0.9), -0.4, 0.4, 0.05}}, {}, DataGrid::kNone, X::kSteer},
       {"steer_rate_limit", "steering servo speed: the applied steer needs T seconds per unit of change", H::kActuator,
        {{"steer_slew_s", &E::steer_slew_s, "s (per unit of normalised steer)", kNonNeg, 0.0, 3.0, 0.05}},
-       {0.1, 0.3, 0.8}, DataGrid::kNone, X::kSteer},
+       {0.1, 0.3, 0.8}, DataGrid::kNone, X::kSteer, "steer"},
       {"throttle_rate_limit", "throttle ramp: the applied throttle needs T seconds per unit of change", H::kActuator,
        {{"throttle_slew_s", &E::throttle_slew_s, "s (per unit of normalised throttle)", kNonNeg, 0.0, 3.0, 0.05}},
-       {0.1, 0.3, 0.8}, DataGrid::kNone, X::kThrottle},
+       {0.1, 0.3, 0.8}, DataGrid::kNone, X::kThrottle, "throttle"},
       {"steer_backlash", "play of width b between the steering servo and the wheels", H::kActuator,
        {{"steer_backlash", &E::steer_backlash, "1 (normalised steer)", closed(0.0, 0.5), 0.0, 0.3, 0.02}},
-       {0.02, 0.05, 0.1}, DataGrid::kNone, X::kSteer},
+       {0.02, 0.05, 0.1}, DataGrid::kNone, X::kSteer, "steer"},
       {"payload", "mass and yaw inertia differ from the nominal (payload, battery)", H::kChassis,
        {{"mass_scale", &E::mass_scale, "1", kScale, 0.5, 2.5, 0.1},
         {"yaw_inertia_scale", &E::yaw_inertia_scale, "1", kScale, 0.5, 2.5, 0.1}}, {0.8, 1.2, 1.5}, DataGrid::kNone, X::kThrottle},

@@ -96,7 +96,7 @@ std::string excitation_shortfall(Excitation needs, const ExcitationLevels& x) {
   return "";
 }
 
-std::string range_limit_shortfall(const EffectSpec& spec, const EffectParams& fitted, double margin) {
+int range_limit_param(const EffectSpec& spec, const EffectParams& fitted, double margin) {
   const EffectParams defaults;
   for (std::size_t i = 0; i < spec.params.size(); ++i) {
     if (static_cast<int>(i) < grid_param_count(spec.data_grid)) continue;  // searched over the data, not bounded
@@ -109,14 +109,20 @@ std::string range_limit_shortfall(const EffectSpec& spec, const EffectParams& fi
     const bool lo_physical = lo_closed && p.valid.lo == p.lo, hi_physical = hi_closed && p.valid.hi == p.hi;
     const bool at_lo = v <= p.lo + tol && std::abs(d - p.lo) > tol && !lo_physical;
     const bool at_hi = v >= p.hi - tol && std::abs(d - p.hi) > tol && !hi_physical;
-    if (at_lo || at_hi) {
-      char buf[200];
-      std::snprintf(buf, sizeof buf, "%s = %.4g sits at the %s end of its search range [%.4g, %.4g]", p.name, v,
-                    at_lo ? "lower" : "upper", p.lo, p.hi);
-      return buf;
-    }
+    if (at_lo || at_hi) return static_cast<int>(i);
   }
-  return "";
+  return -1;
+}
+
+std::string range_limit_shortfall(const EffectSpec& spec, const EffectParams& fitted, double margin) {
+  const int i = range_limit_param(spec, fitted, margin);
+  if (i < 0) return "";
+  const EffectParamSpec& p = spec.params[static_cast<std::size_t>(i)];
+  const double v = fitted.*(p.member);
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "%s = %.4g sits at the %s end of its search range [%.4g, %.4g]", p.name, v,
+                v <= 0.5 * (p.lo + p.hi) ? "lower" : "upper", p.lo, p.hi);
+  return buf;
 }
 
 }  // namespace mppi::diagnose

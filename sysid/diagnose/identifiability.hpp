@@ -31,5 +31,7 @@ std::string excitation_shortfall(Excitation needs, const ExcitationLevels& level
 // of an end of its search range that is not its default and not a closed end of its physical
 // range (a share at 1 is an estimate); then which one and where.
 std::string range_limit_shortfall(const EffectSpec& spec, const EffectParams& fitted, double margin = 0.01);
+// The index into spec.params of the parameter range_limit_shortfall reports, or -1.
+int range_limit_param(const EffectSpec& spec, const EffectParams& fitted, double margin = 0.01);
 
 }  // namespace mppi::diagnose

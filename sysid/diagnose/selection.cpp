@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <deque>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <random>
@@ -422,6 +423,7 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
         std::find(main.chosen.begin(), main.chosen.end(), i) != main.chosen.end())
       stable_pool.push_back(i);
   std::vector<int> inclusion(cands.size(), 0);
+  std::map<std::string, int> dynamics_inclusion;  // resamples that chose some form of an actuator's dynamics
   if (!main.chosen.empty() && opt.stability_resamples > 0) {
     std::mt19937_64 rng(opt.seed * 0x9E3779B97F4A7C15ull + 17);
     const int block = std::max(2, static_cast<int>(std::lround(2.0 / (len * d.dt_s))));  // about 2 s
@@ -438,8 +440,15 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
         opt.progress("stability: resample " + std::to_string(++done) + " of " + std::to_string(opt.stability_resamples) + " done");
       }
     });
-    for (const auto& c : chosen)
+    for (const auto& c : chosen) {
       for (int i : c) ++inclusion[static_cast<std::size_t>(i)];
+      std::vector<std::string> families;  // the actuators whose dynamics this resample chose
+      for (int i : c) {
+        const std::string& f = cands[static_cast<std::size_t>(i)]->dynamics_of;
+        if (!f.empty() && std::find(families.begin(), families.end(), f) == families.end()) families.push_back(f);
+      }
+      for (const auto& f : families) ++dynamics_inclusion[f];
+    }
     std::vector<int> reported;  // the library effects that the pool and the main selection stand for
     for (int i : stable_pool)
       for (int m : members[static_cast<std::size_t>(i)])
@@ -454,9 +463,53 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
       log.push_back(line);
     }
   }
+  // One actuator's dynamics, in whichever form: where the resamples agree that the response of an
+  // actuator is held back but split between its forms (a delay, a lag, a rate limit, a play: with
+  // smooth commands their fits nearly coincide), the dynamics are stable and the form chosen most
+  // often stands for them (on a tie, the one chosen on all the data); the other forms are listed as
+  // suspected. Stability selection of groups of correlated variables works the same way.
+  std::vector<int> family_pick;  // candidates named for their actuator's dynamics
+  if (opt.stability_resamples > 0 && !main.chosen.empty())
+    for (const auto& [family, count] : dynamics_inclusion) {
+      const double share = static_cast<double>(count) / opt.stability_resamples;
+      if (share < opt.min_inclusion_frequency) continue;
+      int pick = -1, pick_count = 0;
+      for (std::size_t i = 0; i < cands.size(); ++i) {
+        if (cands[i]->dynamics_of != family || inclusion[i] == 0) continue;
+        const bool on_all = std::find(main.chosen.begin(), main.chosen.end(), static_cast<int>(i)) != main.chosen.end();
+        if (inclusion[i] > pick_count || (inclusion[i] == pick_count && on_all)) {
+          pick = static_cast<int>(i);
+          pick_count = inclusion[i];
+        }
+      }
+      if (pick < 0 || static_cast<double>(pick_count) / opt.stability_resamples >= opt.min_inclusion_frequency) continue;
+      family_pick.push_back(pick);
+      for (std::size_t i = 0; i < cands.size(); ++i) {
+        if (cands[i]->dynamics_of != family || static_cast<int>(i) == pick || inclusion[i] == 0) continue;
+        std::snprintf(line, sizeof line, "another form of the %s's dynamics, which are named as %s (chosen in %d of %d resamples, this form in %d)",
+                      family.c_str(), cands[static_cast<std::size_t>(pick)]->id.c_str(), pick_count, opt.stability_resamples, inclusion[i]);
+        for (const CandidateFit& c : main.first_round)
+          if (c.index == static_cast<int>(i)) suspect(static_cast<int>(i), line, c.fit.effects);
+      }
+      std::snprintf(line, sizeof line, "stable as the %s's dynamics: some form chosen in %d of %d resamples; named %s (%d of them)",
+                    family.c_str(), count, opt.stability_resamples, cands[static_cast<std::size_t>(pick)]->id.c_str(), pick_count);
+      log.push_back(line);
+    }
+  auto in_family_pick = [&](int i) { return std::find(family_pick.begin(), family_pick.end(), i) != family_pick.end(); };
   std::vector<std::string> named;
   for (int i : main.chosen) {
     const CandidateReport& r = sel.candidates[static_cast<std::size_t>(i)];
+    if (in_family_pick(i)) continue;  // named below, for its actuator's dynamics
+    const std::string& family = cands[static_cast<std::size_t>(i)]->dynamics_of;
+    const auto stands_for = std::find_if(family_pick.begin(), family_pick.end(), [&](int p) {
+      return !family.empty() && cands[static_cast<std::size_t>(p)]->dynamics_of == family;
+    });
+    if (stands_for != family_pick.end()) {
+      std::snprintf(line, sizeof line, "another form of the %s's dynamics, which are named as %s",
+                    family.c_str(), cands[static_cast<std::size_t>(*stands_for)]->id.c_str());
+      suspect(i, line, main.effects);  // no-op where the family's own list above already has it
+      continue;
+    }
     if (opt.stability_resamples > 0 && r.inclusion_frequency < opt.min_inclusion_frequency) {
       std::snprintf(line, sizeof line, "unstable: chosen in %.0f %% of the resamples of the data (< %.0f %%)",
                     100 * r.inclusion_frequency, 100 * opt.min_inclusion_frequency);
@@ -477,11 +530,23 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
       log.push_back(line);
       named.push_back(r.id);
     }
+  EffectParams family_effects = main.effects;  // the family picks' own first-round fits as start values
+  for (int p : family_pick) {
+    named.push_back(cands[static_cast<std::size_t>(p)]->id);
+    for (const CandidateFit& c : main.first_round)
+      if (c.index == p)
+        for (const EffectParamSpec& q : cands[static_cast<std::size_t>(p)]->params) family_effects.*(q.member) = c.fit.effects.*(q.member);
+  }
 
-  // Joint refit of the named effects on all training segments; an effect whose parameter ends at
-  // a bound there is not identified either.
-  EffectParams start = only(named, main.effects);
-  for (int pass = 0; pass < 3 && !named.empty(); ++pass) {
+  // Joint refit of the named effects on all training segments. A parameter that ends at a bound
+  // there is held at its nominal value and the effect's other parameters refitted (the nested,
+  // simpler form: a rolling resistance without its viscous part); an effect with nothing else to
+  // fit is not identified either. Each pass finalises, drops an effect or holds a parameter.
+  EffectParams start = only(named, family_effects);
+  const EffectParams nominal_values;
+  std::vector<double EffectParams::*> held;
+  auto is_held = [&](double EffectParams::*m) { return std::find(held.begin(), held.end(), m) != held.end(); };
+  while (!named.empty()) {
     std::vector<ParamSpec> free;
     std::vector<ParamEstimate> fixed_times;
     for (const auto& id : named) {
@@ -493,22 +558,39 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
             if (c.id == id && !c.params.empty()) fixed_times.back().stddev = c.params[0].stddev;
           continue;
         }
-        if (effect_param_active(s.params[j], start)) free.push_back(s.params[j]);
+        if (effect_param_active(s.params[j], start) && !is_held(s.params[j].member)) free.push_back(s.params[j]);
       }
     }
     const FitResult joint = fit_params(all, start, free);
     std::vector<std::string> keep;
+    bool changed = false;
     for (const auto& id : named) {
-      const std::string limit = range_limit_shortfall(effect_spec(id), joint.effects, opt.range_limit_margin);
-      if (limit.empty()) {
+      const EffectSpec& spec = effect_spec(id);
+      const int at = range_limit_param(spec, joint.effects, opt.range_limit_margin);
+      if (at < 0) {
         keep.push_back(id);
-      } else {
-        for (std::size_t i = 0; i < cands.size(); ++i)
-          if (cands[i]->id == id) suspect(static_cast<int>(i), "not identifiable from this recording: " + limit, joint.effects);
-        log.push_back("joint refit: " + id + " not identified: " + limit);
+        continue;
       }
+      changed = true;
+      const std::string limit = range_limit_shortfall(spec, joint.effects, opt.range_limit_margin);
+      const EffectParamSpec& bound = spec.params[static_cast<std::size_t>(at)];
+      bool others = false;
+      for (std::size_t j = static_cast<std::size_t>(grid_param_count(spec.data_grid)); j < spec.params.size(); ++j)
+        others = others || (static_cast<int>(j) != at && effect_param_active(spec.params[j], joint.effects) &&
+                            !is_held(spec.params[j].member));
+      if (others) {
+        held.push_back(bound.member);
+        keep.push_back(id);
+        std::snprintf(line, sizeof line, "joint refit: %s: %s; held at its nominal value %.4g, the rest refitted", id.c_str(),
+                      limit.c_str(), nominal_values.*(bound.member));
+        log.push_back(line);
+        continue;
+      }
+      for (std::size_t i = 0; i < cands.size(); ++i)
+        if (cands[i]->id == id) suspect(static_cast<int>(i), "not identifiable from this recording: " + limit, joint.effects);
+      log.push_back("joint refit: " + id + " not identified: " + limit);
     }
-    if (keep.size() == named.size()) {
+    if (!changed) {
       sel.final_effects = joint.effects;
       sel.final_params = fixed_times;
       sel.final_params.insert(sel.final_params.end(), joint.params.begin(), joint.params.end());
@@ -516,6 +598,7 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
     }
     named = keep;
     start = only(named, joint.effects);
+    for (auto m : held) start.*m = nominal_values.*m;
     sel.final_effects = {};
     sel.final_params.clear();
   }
