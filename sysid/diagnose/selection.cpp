@@ -16,6 +16,7 @@
 #include "mppi/error.hpp"
 #include "sysid/diagnose/fit.hpp"
 #include "sysid/diagnose/identifiability.hpp"
+#include "sysid/diagnose/joint_refit.hpp"
 
 namespace mppi::diagnose {
 namespace {
@@ -538,69 +539,24 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
         for (const EffectParamSpec& q : cands[static_cast<std::size_t>(p)]->params) family_effects.*(q.member) = c.fit.effects.*(q.member);
   }
 
-  // Joint refit of the named effects on all training segments. A parameter that ends at a bound
-  // there is held at its nominal value and the effect's other parameters refitted (the nested,
-  // simpler form: a rolling resistance without its viscous part); an effect with nothing else to
-  // fit is not identified either. Each pass finalises, drops an effect or holds a parameter.
-  EffectParams start = only(named, family_effects);
-  const EffectParams nominal_values;
-  std::vector<double EffectParams::*> held;
-  auto is_held = [&](double EffectParams::*m) { return std::find(held.begin(), held.end(), m) != held.end(); };
-  while (!named.empty()) {
-    std::vector<ParamSpec> free;
-    std::vector<ParamEstimate> fixed_times;
-    for (const auto& id : named) {
-      const EffectSpec& s = effect_spec(id);
-      for (std::size_t j = 0; j < s.params.size(); ++j) {
-        if (s.data_grid == DataGrid::kTime && j == 0) {
-          fixed_times.push_back({s.params[0].name, s.params[0].unit, start.*(s.params[0].member), 0.0});
-          for (const auto& c : sel.candidates)
-            if (c.id == id && !c.params.empty()) fixed_times.back().stddev = c.params[0].stddev;
-          continue;
-        }
-        if (effect_param_active(s.params[j], start) && !is_held(s.params[j].member)) free.push_back(s.params[j]);
-      }
-    }
-    const FitResult joint = fit_params(all, start, free);
-    std::vector<std::string> keep;
-    bool changed = false;
-    for (const auto& id : named) {
-      const EffectSpec& spec = effect_spec(id);
-      const int at = range_limit_param(spec, joint.effects, opt.range_limit_margin);
-      if (at < 0) {
-        keep.push_back(id);
-        continue;
-      }
-      changed = true;
-      const std::string limit = range_limit_shortfall(spec, joint.effects, opt.range_limit_margin);
-      const EffectParamSpec& bound = spec.params[static_cast<std::size_t>(at)];
-      bool others = false;
-      for (std::size_t j = static_cast<std::size_t>(grid_param_count(spec.data_grid)); j < spec.params.size(); ++j)
-        others = others || (static_cast<int>(j) != at && effect_param_active(spec.params[j], joint.effects) &&
-                            !is_held(spec.params[j].member));
-      if (others) {
-        held.push_back(bound.member);
-        keep.push_back(id);
-        std::snprintf(line, sizeof line, "joint refit: %s: %s; held at its nominal value %.4g, the rest refitted", id.c_str(),
-                      limit.c_str(), nominal_values.*(bound.member));
-        log.push_back(line);
-        continue;
-      }
+  // Joint refit of the named effects on all training segments (parameters at a bound held at
+  // their nominal value, or the effect dropped: sysid/diagnose/joint_refit.hpp).
+  if (!named.empty()) {
+    const JointRefit joint = refit_named_jointly(all, named, only(named, family_effects), opt.range_limit_margin);
+    for (const auto& l : joint.log) log.push_back(l);
+    for (const auto& [id, why] : joint.not_identified)
       for (std::size_t i = 0; i < cands.size(); ++i)
-        if (cands[i]->id == id) suspect(static_cast<int>(i), "not identifiable from this recording: " + limit, joint.effects);
-      log.push_back("joint refit: " + id + " not identified: " + limit);
+        if (cands[i]->id == id) suspect(static_cast<int>(i), "not identifiable from this recording: " + why, joint.effects);
+    named = joint.kept;
+    sel.final_effects = joint.effects;
+    for (const auto& id : named) {  // a change time was searched over the data: its value and spread
+      const EffectSpec& s = effect_spec(id);
+      if (s.data_grid != DataGrid::kTime) continue;
+      sel.final_params.push_back({s.params[0].name, s.params[0].unit, joint.effects.*(s.params[0].member), 0.0});
+      for (const auto& c : sel.candidates)
+        if (c.id == id && !c.params.empty()) sel.final_params.back().stddev = c.params[0].stddev;
     }
-    if (!changed) {
-      sel.final_effects = joint.effects;
-      sel.final_params = fixed_times;
-      sel.final_params.insert(sel.final_params.end(), joint.params.begin(), joint.params.end());
-      break;
-    }
-    named = keep;
-    start = only(named, joint.effects);
-    for (auto m : held) start.*m = nominal_values.*m;
-    sel.final_effects = {};
-    sel.final_params.clear();
+    sel.final_params.insert(sel.final_params.end(), joint.params.begin(), joint.params.end());
   }
   sel.selected = named;
   for (auto& c : sel.candidates) {
