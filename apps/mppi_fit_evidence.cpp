@@ -32,6 +32,7 @@ const char* kEvidenceUsage = R"(usage:
         [--effects A,B] [--pairs N] [--clean N] [--duration S] [--jobs N] [--out DIR] [--md FILE]
         [--vehicle FILE.yaml]  (the car's constants, also the diagnosis' nominal) [--rate HZ]
         [--summarize DIR]  (only the table, from DIR/runs.jsonl of a sweep, finished or not)
+        [--resume]  (keep the runs DIR/runs.jsonl already has, run the rest; same options as before)
         (full grid: 5 seeds, every effect at both sizes, 8 pairs, 20 effect-free; --reduced: 1 seed,
         3 pairs, 4 effect-free). Writes DIR/runs.jsonl, DIR/evidence_sweep.md, DIR/evidence_sweep.json.
 Effects (key=value keys are the fields of sysid/evidence/truth_effects.hpp):
@@ -111,7 +112,7 @@ int evidence_synth(int argc, char** argv) {
 
 int evidence_sweep(int argc, char** argv) {
   diagnose::EvidenceGrid grid;
-  bool reduced = false;
+  bool reduced = false, resume = false;
   int seeds = -1, pairs = -1, clean = -1, jobs = 1;
   std::vector<std::string> sizes, effects;
   double duration = 60;
@@ -124,6 +125,7 @@ int evidence_sweep(int argc, char** argv) {
     };
     if (f == "--generator") value();
     else if (f == "--reduced") reduced = true;
+    else if (f == "--resume") resume = true;
     else if (f == "--seeds") seeds = static_cast<int>(number(f, value()));
     else if (f == "--pairs") pairs = static_cast<int>(number(f, value()));
     else if (f == "--clean") clean = static_cast<int>(number(f, value()));
@@ -166,13 +168,30 @@ int evidence_sweep(int argc, char** argv) {
   grid.vehicle_yaml = vehicle;
   const auto cases = diagnose::evidence_cases(grid);
   std::filesystem::create_directories(out);
-  std::ofstream jsonl(out + "/runs.jsonl");
   std::vector<diagnose::EvidenceRun> runs(cases.size());
+  std::vector<char> done(cases.size(), 0);
+  const std::string jsonl_path = out + "/runs.jsonl";
+  if (resume && std::filesystem::exists(jsonl_path)) {
+    // A sweep cut short goes on where it stopped: runs already recorded (same case, no error) stay.
+    std::size_t kept = 0;
+    for (const auto& previous : diagnose::read_evidence_runs(jsonl_path))
+      for (std::size_t k = 0; k < cases.size(); ++k)
+        if (!done[k] && previous.error.empty() && previous.c.label() == cases[k].label() &&
+            previous.c.assignments == cases[k].assignments) {
+          runs[k] = previous;
+          done[k] = 1;
+          ++kept;
+        }
+    std::printf("resuming: %zu of %zu runs already in %s\n", kept, cases.size(), jsonl_path.c_str());
+  }
+  std::ofstream jsonl(jsonl_path, resume ? std::ios::app : std::ios::trunc);
+  if (!jsonl) throw Error(jsonl_path + ": cannot write");
   std::atomic<std::size_t> next{0};
   std::mutex io;
   std::printf("%zu runs, %d job(s) -> %s\n", cases.size(), jobs, out.c_str());
   auto worker = [&] {
     for (std::size_t k = next++; k < cases.size(); k = next++) {
+      if (done[k]) continue;
       diagnose::DiagnoseOptions o;
       o.plots = false;
       runs[k] = diagnose::run_evidence_case(cases[k], out, grid.duration_s, o, grid.vehicle_yaml, grid.rate_hz);
