@@ -14,6 +14,7 @@
 #include "plot/html_report.hpp"
 
 #include "mppi/error.hpp"
+#include "sysid/diagnose/control_loss.hpp"
 #include "sysid/diagnose/plots.hpp"
 
 namespace mppi::diagnose {
@@ -75,8 +76,32 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
   const ResidualSeries rs = residual_series(nominal_model, d, o.locate_horizon_s, o.replay);
   res.mismatch = locate(d, rs, train);
 
-  // 2. Name.
-  res.selection = select_effects(d, nominal, train, held, o.selection, o.replay);
+  // 2. Name, without the rows of lost control where enough is left.
+  std::vector<char> select_rows = train;
+  const std::vector<char> lost = control_loss_rows(d, o.control_loss);
+  std::size_t n_train = 0;
+  for (std::size_t k = 0; k < d.rows(); ++k) {
+    n_train += train[k] != 0;
+    res.control_loss_rows += train[k] && lost[k];
+  }
+  std::string control_loss_line;
+  if (res.control_loss_rows > 0) {
+    for (std::size_t k = 0; k < d.rows(); ++k)
+      if (lost[k]) select_rows[k] = 0;
+    const int len = std::max(2, static_cast<int>(std::lround(o.selection.fit_horizon_s / d.dt_s)));
+    const bool enough = 2 * res.control_loss_rows < n_train && make_segments(d, select_rows, len, len).size() >= 12;
+    char line[320];
+    std::snprintf(line, sizeof line,
+                  "%zu of %zu training rows (%.1f %%) are lost control (body slip > %.0f deg above %.1f m/s, and %.1f s around): %s",
+                  res.control_loss_rows, n_train, 100.0 * static_cast<double>(res.control_loss_rows) / static_cast<double>(n_train),
+                  o.control_loss.max_body_slip_deg, o.control_loss.min_speed_mps, o.control_loss.guard_s,
+                  enough ? "left out of the fits and their validation" : "kept (too little would be left)");
+    control_loss_line = line;
+    if (!enough) select_rows = train;
+    if (o.selection.progress) o.selection.progress(control_loss_line);
+  }
+  res.selection = select_effects(d, nominal, select_rows, held, o.selection, o.replay);
+  if (!control_loss_line.empty()) res.selection.log.insert(res.selection.log.begin(), control_loss_line);
   const auto corrected_ptr = nominal.make(res.selection.final_effects);
   const ReplayModel& corrected = *corrected_ptr;
 
@@ -128,6 +153,7 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
   j["model"] = nominal.name();
   j["params"] = o.params_source;
   j["rows"] = d.rows();
+  j["control_loss_rows"] = res.control_loss_rows;
   j["dt_s"] = d.dt_s;
   j["holdout"] = o.holdout;
   j["screening"] = screening_json(d);

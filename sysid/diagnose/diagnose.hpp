@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "sysid/diagnose/control_loss.hpp"
 #include "sysid/diagnose/data.hpp"
 #include "sysid/diagnose/fit.hpp"
 #include "sysid/diagnose/locate.hpp"
@@ -20,6 +21,9 @@ struct DiagnoseOptions {
   std::vector<double> horizons_s = {0.2, 0.5, 1.0, 2.0};  // multi-step horizons reported [s]
   double headline_horizon_s = 1.0;      // the multi-step RMSE the summary quotes [s]
   SelectionOptions selection;
+  // Rows of lost control (spins) are left out of the selection's fits and validation (not out of
+  // the located mismatch, nor out of the held-out judgement): control_loss.hpp.
+  ControlLossOptions control_loss;
   ReplayOptions replay;
   bool plots = true;
   std::string params_source;            // nominal parameter file, for the report
@@ -38,6 +42,7 @@ struct DiagnoseResult {
   std::vector<HorizonMetrics> before, after;  // held out: one-step first, then options.horizons_s
   double headline_before = 0, headline_after = 0;  // normalised RMSE at the headline horizon
   double heldout_rmse_reduction = 0;          // 1 - after / before at the headline horizon
+  std::size_t control_loss_rows = 0;          // training rows of lost control (left out of the selection where enough is left)
   // Share of the held-out squared error at the headline horizon that the correction removes,
   // per channel (1 - (RMSE after / before)^2), and where the rest sits (the corrected model's
   // residuals located on the held-out part, strongest first).
