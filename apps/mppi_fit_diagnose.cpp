@@ -349,6 +349,10 @@ void add_diagnose_options(CLI::App& cmd, DiagnoseArgs& a) {
                  "validation-cost reduction an effect must give")
       ->type_name("F");
   cmd.add_option("--min-bic-drop", a.o.selection.min_bic_drop, "and BIC decrease")->type_name("B");
+  cmd.add_option("--max-body-slip", a.o.control_loss.max_body_slip_deg,
+                 "rows whose body slip exceeds this (a spin), and 0.5 s around, are left out of the fits (0: none)")
+      ->type_name("DEG")
+      ->check(CLI::Range(0.0, 90.0));
   mppi::cli::add_out_option(cmd, a.o.out_dir, "report.json, report.md, PNG plots, corrected_model.yaml");
   cmd.add_flag("--no-plots", a.no_plots, "skip the PNG plots");
   cmd.add_flag("--quiet", a.quiet, "no progress on stderr (the selection log as it is written)");

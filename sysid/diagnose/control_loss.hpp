@@ -10,7 +10,9 @@
 namespace mppi::diagnose {
 
 struct ControlLossOptions {
-  double max_body_slip_deg = 45.0;  // |angle between velocity and heading| above this is a spin (0: off)
+  // |angle between velocity and heading| above this is a spin (0: off). Controlled drifts and
+  // powerslides stay below it (AutoRally's peak about 40 deg, drifting cars about 50).
+  double max_body_slip_deg = 60.0;
   double min_speed_mps = 1.0;       // below this the slip angle means nothing
   double guard_s = 0.5;             // rows this close to a spin count with it (its onset, its recovery)
 };

@@ -34,16 +34,16 @@ DiagData straight_at(double vx_mps, std::size_t rows) {
 
 TEST_CASE("rows of lost control: body slip above the limit at speed, with a guard either side", "[diagnose]") {
   DiagData d = straight_at(5.0, 300);
-  for (std::size_t k = 100; k < 105; ++k) d.vy[k] = 6.0;  // atan(6 / 5) = 50 deg: a spin
+  for (std::size_t k = 100; k < 105; ++k) d.vy[k] = 10.0;  // atan(10 / 5) = 63 deg: a spin
   for (std::size_t k = 200; k < 210; ++k) {               // reversing with a little slip: 5.7 deg
     d.vx[k] = -5.0;
     d.vy[k] = 0.5;
   }
-  for (std::size_t k = 250; k < 260; ++k) {  // 59 deg, but at 0.58 m/s: slip means nothing there
+  for (std::size_t k = 250; k < 260; ++k) {  // 69 deg, but at 0.85 m/s: slip means nothing there
     d.vx[k] = 0.3;
-    d.vy[k] = 0.5;
+    d.vy[k] = 0.8;
   }
-  for (std::size_t k = 280; k < 282; ++k) d.vy[k] = 4.0;  // 38.7 deg: a powerslide, kept
+  for (std::size_t k = 280; k < 282; ++k) d.vy[k] = 6.0;  // 50 deg: a drift, kept
   const std::vector<char> lost = control_loss_rows(d);
   REQUIRE(lost.size() == 300);
   // 0.5 s guard = 25 rows: rows 75 .. 129.
@@ -55,7 +55,7 @@ TEST_CASE("rows of lost control: body slip above the limit at speed, with a guar
   off.max_body_slip_deg = 0;
   for (char c : control_loss_rows(d, off)) CHECK(c == 0);
   ControlLossOptions strict;
-  strict.max_body_slip_deg = 30;  // now the 38.7 deg slide counts too (rows 255 .. 281 + 25, clipped)
+  strict.max_body_slip_deg = 45;  // now the 50 deg drift counts too (rows 255 .. 281 + 25, clipped)
   const auto more = control_loss_rows(d, strict);
   CHECK(more[280] == 1);
   CHECK(more[299] == 1);
