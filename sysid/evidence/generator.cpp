@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -85,11 +86,16 @@ std::string clean_path_of(const std::string& csv_path) { return stem_of(csv_path
 std::string truth_path_of(const std::string& csv_path) { return stem_of(csv_path) + ".truth.json"; }
 
 double log_interval_s(double rate_hz, double physics_dt_s) {
-  if (!(rate_hz >= 5 && rate_hz <= 500)) throw Error("evidence: the log rate must be in [5, 500] Hz, got " + std::to_string(rate_hz));
+  auto shortest = [](double v) {  // 33 and 0.002, not 33.000000 and 0.002000
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", v);
+    return std::string(b);
+  };
+  if (!(rate_hz >= 5 && rate_hz <= 500)) throw Error("evidence: the log rate must be in [5, 500] Hz, got " + shortest(rate_hz));
   const double steps = 1.0 / (rate_hz * physics_dt_s);
   if (std::abs(steps - std::round(steps)) > 1e-9 * steps)
-    throw Error("evidence: the log rate " + std::to_string(rate_hz) + " Hz is not a whole number of " +
-                std::to_string(physics_dt_s) + " s physics steps (e.g. 10, 20, 25, 50, 100, 200 Hz)");
+    throw Error("evidence: the log rate " + shortest(rate_hz) + " Hz is not a whole number of " +
+                shortest(physics_dt_s) + " s physics steps (e.g. 10, 20, 25, 50, 100, 200 Hz)");
   return std::round(steps) * physics_dt_s;
 }
 
