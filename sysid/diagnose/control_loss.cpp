@@ -2,14 +2,24 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
+
+#include "mppi/error.hpp"
 
 namespace mppi::diagnose {
 
 std::vector<char> control_loss_rows(const DiagData& d, const ControlLossOptions& o) {
+  if (!(o.max_body_slip_deg >= 0 && o.max_body_slip_deg <= 90) || !(o.min_speed_mps >= 0) || !std::isfinite(o.min_speed_mps) ||
+      !(o.guard_s >= 0) || !std::isfinite(o.guard_s)) {
+    char why[200];
+    std::snprintf(why, sizeof why, "a body slip limit in [0, 90] deg (0: off), a speed >= 0 and a guard >= 0 s; got %g deg, %g m/s, %g s",
+                  o.max_body_slip_deg, o.min_speed_mps, o.guard_s);
+    throw Error(d.source + ": lost-control options need " + why);
+  }
   const std::size_t n = d.rows();
   std::vector<char> out(n, 0);
-  if (!(o.max_body_slip_deg > 0) || n == 0) return out;
+  if (o.max_body_slip_deg == 0 || n == 0) return out;
   const double limit_rad = o.max_body_slip_deg * std::numbers::pi / 180.0;
   const std::ptrdiff_t guard = static_cast<std::ptrdiff_t>(std::lround(o.guard_s / d.dt_s));
   for (std::size_t k = 0; k < n; ++k) {

@@ -15,7 +15,7 @@
 #include "sysid/diagnose/synth.hpp"
 #include "sysid/evidence/generator.hpp"
 #include "sysid/evidence/truth_effects.hpp"
-#include "test_data.hpp"
+#include "diagnose_fixtures.hpp"
 
 using namespace mppi;
 using namespace mppi::diagnose;
@@ -41,15 +41,8 @@ TEST_CASE("a steering play that the resamples split with a lag is named as the s
   const auto dir = std::filesystem::temp_directory_path() / "mppi_actuator_dynamics_test";
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
-  evidence::EvidenceOptions o;
-  o.duration_s = 40;
-  o.seed = 2;
-  o.track = "ccrf";
-  o.direction = "ccw";
-  o.driver = "human";
-  o.vehicle_yaml = mppi::test::data_path("config/autorally_single_track.yaml");
-  o.truth_names = evidence::set_truth_effects("steer_backlash=0.1", &o.truth);
-  const evidence::EvidenceResult rec = evidence::generate_evidence(o, (dir / "play.csv").string());
+  const evidence::EvidenceResult rec =
+      mppi::test::independent_recording(dir / "play.csv", "steer_backlash=0.1", 2, "ccrf", "ccw", "human");
 
   const DiagData d = load_recording(rec.csv);
   DiagnoseOptions opt;
@@ -73,15 +66,7 @@ TEST_CASE("a steering play that the resamples split with a lag is named as the s
 }
 
 TEST_CASE("a parameter at the end of its range in the joint refit is held at its nominal value", "[diagnose]") {
-  static const auto family = make_model_family("single-track");
-  auto problem = [&](const DiagData& d) {
-    FitProblem p;
-    p.data = &d;
-    p.family = family.get();
-    p.segments = make_segments(d, {}, 25, 25);
-    p.scale = channel_scales(d, {});
-    return p;
-  };
+  auto problem = [](const DiagData& d) { return mppi::test::training_problem(d); };
   SECTION("one grade beyond the search range: held at 0, the other grade refitted") {
     EffectParams truth;
     parse_effect_assignments("grade_x=0.06,grade_y=0.4", &truth);  // dz/dy beyond the search range [-0.3, 0.3]

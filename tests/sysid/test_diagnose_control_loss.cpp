@@ -12,7 +12,7 @@
 #include "sysid/diagnose/model_family.hpp"
 #include "sysid/evidence/generator.hpp"
 #include "sysid/evidence/truth_effects.hpp"
-#include "test_data.hpp"
+#include "diagnose_fixtures.hpp"
 
 using namespace mppi;
 using namespace mppi::diagnose;
@@ -62,6 +62,24 @@ TEST_CASE("rows of lost control: body slip above the limit at speed, with a guar
   CHECK(more[254] == 0);
 }
 
+TEST_CASE("lost-control options out of range are refused by name", "[diagnose]") {
+  DiagData d = straight_at(5.0, 100);
+  d.source = "drive.csv";
+  const auto refused = [&](double slip_deg, double speed_mps, double guard_s) {
+    ControlLossOptions o;
+    o.max_body_slip_deg = slip_deg;
+    o.min_speed_mps = speed_mps;
+    o.guard_s = guard_s;
+    return o;
+  };
+  CHECK_THROWS_WITH(control_loss_rows(d, refused(95, 1, 0.5)), Catch::Contains("drive.csv") && Catch::Contains("got 95 deg"));
+  CHECK_THROWS_WITH(control_loss_rows(d, refused(std::nan(""), 1, 0.5)), Catch::Contains("[0, 90] deg"));
+  CHECK_THROWS_WITH(control_loss_rows(d, refused(60, -1, 0.5)), Catch::Contains("got 60 deg, -1 m/s"));
+  CHECK_THROWS_WITH(control_loss_rows(d, refused(60, 1, -0.5)), Catch::Contains("-0.5 s"));
+  CHECK_THROWS_WITH(control_loss_rows(d, refused(60, 1, INFINITY)), Catch::Contains("guard >= 0 s"));
+  CHECK(control_loss_rows(d, refused(0, 1, 0.5)) == std::vector<char>(100, 0));  // 0: off
+}
+
 // The independent generator's pursuit driver spins a car with a 0.1 play in its steering 8 times
 // in 40 s on Marietta. Fitted with the spins, every candidate bends towards them (a play of 0.3 at
 // its range limit, a delay of 0.15 s) and fails on the later data, so nothing is named.
@@ -69,15 +87,8 @@ TEST_CASE("a steering play is named on a recording whose car spins before its cr
   const auto dir = std::filesystem::temp_directory_path() / "mppi_control_loss_test";
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
-  evidence::EvidenceOptions o;
-  o.duration_s = 40;
-  o.seed = 1;
-  o.track = "marietta";
-  o.direction = "ccw";
-  o.driver = "pursuit";
-  o.vehicle_yaml = mppi::test::data_path("config/autorally_single_track.yaml");
-  o.truth_names = evidence::set_truth_effects("steer_backlash=0.1", &o.truth);
-  const evidence::EvidenceResult rec = evidence::generate_evidence(o, (dir / "spins.csv").string());
+  const evidence::EvidenceResult rec =
+      mppi::test::independent_recording(dir / "spins.csv", "steer_backlash=0.1", 1, "marietta", "ccw", "pursuit");
   REQUIRE(rec.crashes >= 5);
 
   const DiagData d = load_recording(rec.csv);

@@ -16,22 +16,14 @@
 #include "sysid/diagnose/effects.hpp"
 #include "sysid/diagnose/fit.hpp"
 #include "sysid/diagnose/synth.hpp"
+#include "diagnose_fixtures.hpp"
 
 using namespace mppi;
 using namespace mppi::diagnose;
 
 namespace {
 
-// Training problem over the whole recording: 0.5 s segments.
-FitProblem problem_for(const DiagData& d) {
-  static const auto family = make_model_family("single-track");
-  FitProblem p;
-  p.data = &d;
-  p.family = family.get();
-  p.segments = make_segments(d, {}, 25, 25);
-  p.scale = channel_scales(d, {});
-  return p;
-}
+FitProblem problem_for(const DiagData& d) { return mppi::test::training_problem(d); }
 
 double value_of(const FitResult& r, const std::string& name) {
   for (const auto& p : r.params)

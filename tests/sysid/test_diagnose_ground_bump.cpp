@@ -15,7 +15,7 @@
 #include "sysid/diagnose/data.hpp"
 #include "sysid/evidence/generator.hpp"
 #include "sysid/evidence/truth_effects.hpp"
-#include "test_data.hpp"
+#include "diagnose_fixtures.hpp"
 
 using namespace mppi;
 using namespace mppi::diagnose;
@@ -24,15 +24,8 @@ TEST_CASE("a raised-cosine hill on the track is named as a ground bump at its pl
   const auto dir = std::filesystem::temp_directory_path() / "mppi_ground_bump_test";
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
-  evidence::EvidenceOptions o;
-  o.duration_s = 40;
-  o.seed = 1;
-  o.track = "gazebo";
-  o.direction = "ccw";
-  o.driver = "pursuit";
-  o.vehicle_yaml = mppi::test::data_path("config/autorally_single_track.yaml");
-  o.truth_names = evidence::set_truth_effects("bump_height_m=0.6,bump_radius_m=12", &o.truth);
-  const evidence::EvidenceResult rec = evidence::generate_evidence(o, (dir / "bump.csv").string());
+  const evidence::EvidenceResult rec =
+      mppi::test::independent_recording(dir / "bump.csv", "bump_height_m=0.6,bump_radius_m=12", 1, "gazebo", "ccw", "pursuit");
 
   // The hill's centre from the truth file: effects[0].sizes.centre_m = [x, y].
   std::ifstream truth_file(rec.truth_json);
