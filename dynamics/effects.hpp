@@ -28,6 +28,8 @@
 //                                         quarter of a metre wide). The second and third discs
 //                                         are optional: radius 0 = no disc
 //             load_transfer               CG height h -> h + dh (pitch load transfer)
+//             weight_distribution         the CG sits s of the wheelbase L further back: l_f + s L,
+//                                         l_r - s L (the axles' static loads; s < 0: forward)
 //             payload                     mass x m, yaw inertia x j
 //             motor_speed                 no-load speed x v (the motor's torque-speed line)
 //             motor_freewheel             share f of the drive's back-EMF braking that acts only
@@ -35,8 +37,17 @@
 //                                         F_stall (u - v / v_nl ((1 - f) + f |u|)); f = 1 is the
 //                                         (a - b v) u motor law of RC-car models (an ESC that
 //                                         lets the motor freewheel in the off-time). Needs the
-//                                         single-track core's motor; added as a body force
-//                                         from v_x (the wheels roll without slip on average)
+//                                         single-track core's motor; applied as the command
+//                                         that gives this torque through the base's motor law
+//                                         (so the tyres still limit it)
+//             drag_brake                  the ESC's drag brake: with the command in its neutral
+//                                         band the ESC brakes the driven wheels with the torque
+//                                         that decelerates the car by a_db (m R a_db). Applied as
+//                                         the command that adds this torque through the base's
+//                                         motor law (so the tyres still limit it), from the driven
+//                                         wheels' speed; single-track-core models only. With
+//                                         motor_freewheel (f = 1: no back-EMF braking at neutral)
+//                                         it is the neutral of a PWM ESC in drive-brake mode
 //   sensor:   gyro_bias                   the yaw-rate gyro reads r + b
 //             speed_sensor_scale          the velocity sensor reads s (vx, vy)
 //             time_offset                 states are stamped t_off late against the commands.
@@ -79,6 +90,7 @@ struct EffectParams {
   double grip_scale = 1.0;           // [-] grip factor g after the change
   double grip_change_time_s = 0.0;   // [s] time of the grip change (time is a state)
   double cg_height_delta_m = 0.0;    // [m] dh added to the CG height
+  double cg_shift_rear = 0.0;        // [-] s: the CG moves s x wheelbase towards the rear axle
   double voltage_sag = 0.0;          // [-] k in u - k max(u,0)^2
   double grade_x = 0.0;              // [-] slope dz/dx of the ground plane
   double grade_y = 0.0;              // [-] slope dz/dy of the ground plane
@@ -92,6 +104,7 @@ struct EffectParams {
   double yaw_inertia_scale = 1.0;    // [-] payload: yaw inertia x j
   double motor_speed_scale = 1.0;    // [-] no-load speed x v
   double motor_freewheel_share = 0.0; // [-] f: share of the back-EMF braking scaled by |u|
+  double drag_brake_mps2 = 0.0;      // [m/s^2] the ESC's drag brake at neutral command
   double gyro_bias_radps = 0.0;      // [rad/s] measured yaw rate = r + b
   double speed_scale = 1.0;          // [-] measured vx, vy = s x true
   double time_offset_s = 0.0;        // [s] states stamped late against the commands
@@ -220,6 +233,9 @@ inline const std::vector<EffectSpec>& effect_table() {
         {"bump_height_m", &E::bump_height_m, "m", kAny, -2.0, 2.0, 0.05}}, {}, DataGrid::kPlace, X::kAny},
       {"load_transfer", "pitch load transfer: CG height h + dh", H::kChassis,
        {{"cg_height_delta_m", &E::cg_height_delta_m, "m", kAny, -0.115, 0.12, 0.02}}, {}, DataGrid::kNone, X::kBraking},
+      {"weight_distribution", "the CG sits elsewhere along the wheelbase: l_f + s L, l_r - s L (s > 0: rearward)", H::kChassis,
+       {{"cg_shift_rear", &E::cg_shift_rear, "1 (of the wheelbase)", open(-1.0, 1.0), -0.4, 0.4, 0.02}}, {-0.1, 0.1},
+       DataGrid::kNone, X::kAny},
       {"motor_voltage_sag", "drive falls with current: throttle u - k max(u,0)^2", H::kActuator,
        {{"voltage_sag", &E::voltage_sag, "1", {0.0, 1.0, Bounds::kOpenHigh}, 0.0, 0.9, 0.05}}, {}, DataGrid::kNone, X::kThrottle},
       {"road_grade", "tilted ground plane z = gx x + gy y", H::kForce,
@@ -248,6 +264,10 @@ inline const std::vector<EffectSpec>& effect_table() {
       {"motor_freewheel", "the motor's back-EMF braking acts only while the PWM is on: F_stall (u - v/v_nl ((1-f) + f|u|))",
        H::kChassis,
        {{"freewheel_share", &E::motor_freewheel_share, "1", closed(0.0, 1.0), 0.0, 1.0, 0.1}}, {0.3, 0.7},
+       DataGrid::kNone, X::kThrottle},
+      {"drag_brake", "the ESC's drag brake: at neutral command a brake torque that decelerates the car by a_db",
+       H::kChassis,
+       {{"drag_brake_mps2", &E::drag_brake_mps2, "m/s^2", kNonNeg, 0.0, 8.0, 0.5}}, {1.0, 3.0},
        DataGrid::kNone, X::kThrottle},
       {"gyro_bias", "sensor fault: the yaw-rate gyro reads r + b", H::kSensor,
        {{"gyro_bias_radps", &E::gyro_bias_radps, "rad/s", kAny, -0.5, 0.5, 0.01}}, {}, DataGrid::kNone, X::kSteer},
@@ -318,6 +338,9 @@ inline SingleTrackParams apply_effect_params(SingleTrackParams p, const EffectPa
   p.tyre.Sv *= grip;
   p.tyre.B *= e.tyre_stiffness_scale / e.tyre_peak_scale;
   p.cg_height_m += e.cg_height_delta_m;
+  const double wheelbase_m = p.cg_to_front_axle_m + p.cg_to_rear_axle_m;
+  p.cg_to_front_axle_m += e.cg_shift_rear * wheelbase_m;
+  p.cg_to_rear_axle_m -= e.cg_shift_rear * wheelbase_m;
   p.mass_kg *= e.mass_scale;
   p.yaw_inertia_kgm2 *= e.yaw_inertia_scale;
   p.no_load_speed_mps *= e.motor_speed_scale;
@@ -336,6 +359,10 @@ struct ActuatorCoeffs {
   ChainCoeffs steer, throttle;
 };
 inline constexpr float kInfF = std::numeric_limits<float>::infinity();
+
+// The neutral band of an ESC (normalised command): the drag brake acts fully within
+// kEscNeutralFull of 0 and fades out linearly to kEscNeutralEdge (hobby ESCs: about 5-10 %).
+inline constexpr float kEscNeutralFull = 0.05f, kEscNeutralEdge = 0.10f;
 inline ActuatorCoeffs actuator_coeffs(const EffectParams& e, float dt_s) noexcept {
   auto a = [dt_s](double tau) { return tau > 0 ? static_cast<float>(1.0 - std::exp(-dt_s / tau)) : 1.f; };
   const auto step = [dt_s](double slew_s) { return slew_s > 0 ? static_cast<float>(dt_s / slew_s) : kInfF; };

@@ -90,9 +90,14 @@ class WithEffects {
     drag_per_kg_ = static_cast<float>(effects_.aero_drag_kgpm / m);
     roll_per_kg_ = static_cast<float>(effects_.rolling_force_N / m);
     visc_per_kg_ = static_cast<float>(effects_.rolling_viscous_Nspm / m);
-    if constexpr (kChassisEffects)  // the motor's back-EMF force at speed v_nl: F_stall = T_stall / R
-      freewheel_per_kg_ = static_cast<float>(effects_.motor_freewheel_share * car.stall_torque_Nm /
-                                             (car.wheel_radius_m * m * car.no_load_speed_mps));
+    if constexpr (kChassisEffects) {  // motor_freewheel, drag_brake: in units of the normalised command
+      esc_ = effects_.motor_freewheel_share > 0.0 || effects_.drag_brake_mps2 > 0.0;
+      freewheel_per_mps_ = static_cast<float>(effects_.motor_freewheel_share / car.no_load_speed_mps);
+      drag_brake_cmd_ = static_cast<float>(effects_.drag_brake_mps2 * m * car.wheel_radius_m / car.stall_torque_Nm);
+      brake_ratio_ = static_cast<float>(car.brake_torque_ratio);
+      inv_brake_ratio_ = car.brake_torque_ratio > 0.0 ? static_cast<float>(1.0 / car.brake_torque_ratio) : 0.f;
+      wheel_radius_ = static_cast<float>(car.wheel_radius_m);
+    }
     grade_x_ = static_cast<float>(g * effects_.grade_x);
     grade_y_ = static_cast<float>(g * effects_.grade_y);
     bump_ = effects_.bump_height_m != 0.0 && effects_.bump_radius_m > 0.0;
@@ -162,6 +167,32 @@ class WithEffects {
     return throttle_gain_ * t + thr_offset_ - sag_ * t_pos * t_pos;
   }
 
+  // motor_freewheel and drag_brake: the command u' that makes the base's motor law
+  // T_stall (max(u', 0) + k_brake min(u', 0) - v / v_nl) give the ESC's torque
+  //   T_stall (max(u, 0) + k_brake min(u, 0) - v / v_nl ((1 - f) + f |u|)) - m R a_db n(u) tanh(2 v),
+  // n = 1 in the ESC's neutral band; v is the driven wheels' rim speed omega_r R, as in the base's
+  // law. So the tyres still limit the torque. A base without a brake (k_brake = 0) cannot brake:
+  // the negative part is dropped.
+  float esc_throttle(float u, float rim_mps) const noexcept {
+    const float torque = std::max(u, 0.f) + brake_ratio_ * std::min(u, 0.f);
+    const float duty = std::min(std::abs(u), 1.f);
+    const float neutral = std::clamp((kEscNeutralEdge - std::abs(u)) / (kEscNeutralEdge - kEscNeutralFull), 0.f, 1.f);
+    const float g = torque + freewheel_per_mps_ * (1.f - duty) * rim_mps -
+                    drag_brake_cmd_ * neutral * phys::tanh(rim_mps * 2.f);
+    return g >= 0.f ? g : g * inv_brake_ratio_;
+  }
+  // The driven (rear) wheels' rim speed omega_r R of lane j, as the base's motor sees it.
+  template <int W>
+  float rear_rim_speed(Batch<kNx, W> x, int j) const noexcept {
+    if constexpr (requires { Base::kOmegaRear; }) {
+      return x[Base::kOmegaRear][j] * wheel_radius_;
+    } else if constexpr (kOmega >= 0) {  // four wheels: the differential carrier's speed
+      return 0.5f * (x[kOmega + wheel::kLR][j] + x[kOmega + wheel::kRR][j]) * wheel_radius_;
+    } else {
+      return x[state::kVx][j];
+    }
+  }
+
   template <int W>
   void step(Batch<kNx, W> x, ConstBatch<kNu, W> u, float dt_s, float* scratch) const noexcept {
     const ActuatorCoeffs k = actuator_coeffs(effects_, dt_s);
@@ -186,13 +217,11 @@ class WithEffects {
       const float vx = x[state::kVx][j];
       float sy, cy;
       fast_sincos(x[state::kYaw][j], &sy, &cy);
-      // motor_freewheel: the share f of the base's back-EMF braking F_stall v / v_nl that the
-      // command's off-time takes away, f (1 - |u|) F_stall v / v_nl.
-      const float duty = std::min(std::abs(applied[control::kThrottle * W + j]), 1.f);
+      if (esc_) applied[control::kThrottle * W + j] = esc_throttle(applied[control::kThrottle * W + j], rear_rim_speed<W>(x, j));
       float gx = grade_x_, gy = grade_y_;  // g x the ground's slope here (plane + bump)
       if (bump_) add_bump_slope(x[state::kX][j], x[state::kY][j], &gx, &gy);
       ax[j] = -drag_per_kg_ * vx * std::abs(vx) - roll_per_kg_ * phys::tanh(vx * 2.f) - visc_per_kg_ * vx -
-              (gx * cy + gy * sy) + freewheel_per_kg_ * (1.f - duty) * vx;
+              (gx * cy + gy * sy);
       ay[j] = -(-gx * sy + gy * cy);
       other_w[j] = other_grip_weight(x[kTime][j], x[state::kX][j], x[state::kY][j]);
       before_lanes += other_w[j] == 0.f;
@@ -307,7 +336,7 @@ class WithEffects {
   Base nominal_;
   EffectParams effects_;
   Base before_, after_;
-  float drag_per_kg_ = 0, roll_per_kg_ = 0, visc_per_kg_ = 0, freewheel_per_kg_ = 0, grade_x_ = 0, grade_y_ = 0, change_time_ = 0;
+  float drag_per_kg_ = 0, roll_per_kg_ = 0, visc_per_kg_ = 0, grade_x_ = 0, grade_y_ = 0, change_time_ = 0;
   bool grip_changes_ = false, patch_ = false, bump_ = false;
   float bump_x_ = 0, bump_y_ = 0, bump_r_ = 0, bump_slope_ = 0;
   struct Disc {
@@ -317,6 +346,8 @@ class WithEffects {
   int discs_n_ = 0;
   float gain_ = 1, offset_ = 0, steer_cubic_ = 0, left_gain_ = 1, right_gain_ = 1;  // steering map
   float throttle_gain_ = 1, thr_offset_ = 0, sag_ = 0;                              // throttle map
+  bool esc_ = false;  // motor_freewheel, drag_brake
+  float freewheel_per_mps_ = 0, drag_brake_cmd_ = 0, brake_ratio_ = 1, inv_brake_ratio_ = 1, wheel_radius_ = 1;
 };
 
 using CorrectedSingleTrack = WithEffects<SingleTrack>;

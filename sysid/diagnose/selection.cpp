@@ -349,14 +349,16 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
       cands.push_back(&effect_spec(id));
     }
   }
-  // Partner terms on one command are also fitted together, as one joint candidate: a steering
-  // map's gain and trim, a throttle map's gain and offset. Where both are wrong, each alone takes
-  // up part of the other's error and can fail where the two together explain the data.
+  // Partner terms are also fitted together, as one joint candidate: a steering map's gain and
+  // trim, a throttle map's gain and offset, and an ESC's neutral (the motor freewheeling, no
+  // back-EMF braking, and a drag brake instead). Where both are wrong, each alone takes up part of
+  // the other's error and can fail where the two together explain the data.
   Members members(cands.size());
   for (std::size_t i = 0; i < cands.size(); ++i) members[i] = {static_cast<int>(i)};
   std::deque<EffectSpec> joint_specs;
   static const std::pair<const char*, const char*> kPartners[] = {{"steer_gain", "steer_offset"},
-                                                                   {"throttle_gain", "throttle_offset"}};
+                                                                   {"throttle_gain", "throttle_offset"},
+                                                                   {"motor_freewheel", "drag_brake"}};
   for (const auto& [a, b] : kPartners) {
     int ia = -1, ib = -1;
     for (std::size_t i = 0; i < cands.size(); ++i) {

@@ -106,18 +106,19 @@ CarState car_derivative(const CarConstants& c, const CarState& s, const CarInput
   const double m = c.mass_kg * in.mass_scale, iz = c.yaw_inertia_kgm2 * in.yaw_inertia_scale;
   const double weight = m * c.gravity_mps2;
   const double vx = s[kVx], vy = s[kVy], r = s[kR];
+  const double lf_m = c.lf_m + in.cg_rearward_m, lr_m = c.lr_m - in.cg_rearward_m;
   const double d = in.wheel_angle_rad, cd = std::cos(d), sd = std::sin(d);
   // Contact-patch velocities in each tyre's frame.
-  const double front_lat_body = vy + c.lf_m * r;
+  const double front_lat_body = vy + lf_m * r;
   const double fvx = cd * vx + sd * front_lat_body, fvy = cd * front_lat_body - sd * vx;
-  const double rvx = vx, rvy = vy - c.lr_m * r;
+  const double rvx = vx, rvy = vy - lr_m * r;
   double fmx, fmy, rmx, rmy;
   tyre_coefficients(c, false, fvx, fvy, s[kWf] * c.wheel_radius_m, in.grip_scale, &fmx, &fmy);
   tyre_coefficients(c, true, rvx, rvy, s[kWr] * c.wheel_radius_m, in.grip_scale, &rmx, &rmy);
   // Pitch load transfer from the moment balance about the rear contact (explicit in the
   // friction coefficients, which do not depend on the loads).
-  const double wheelbase_term = c.lf_m + c.lr_m + c.cg_height_m * (fmx * cd - fmy * sd - rmx);
-  double fz_front = weight * (c.lr_m - c.cg_height_m * rmx) / std::max(wheelbase_term, 1e-3);
+  const double wheelbase_term = lf_m + lr_m + c.cg_height_m * (fmx * cd - fmy * sd - rmx);
+  double fz_front = weight * (lr_m - c.cg_height_m * rmx) / std::max(wheelbase_term, 1e-3);
   fz_front = std::clamp(fz_front, 0.0, weight);
   const double fz_rear = weight - fz_front;
   const double ffx = fmx * fz_front, ffy = fmy * fz_front, frx = rmx * fz_rear, fry = rmy * fz_rear;
@@ -135,7 +136,7 @@ CarState car_derivative(const CarConstants& c, const CarState& s, const CarInput
   const double rear_roll = -in.rear_rolling_coefficient * fz_rear * std::tanh(rvx / c.rolling_speed_mps);
   resist_x += front_roll * cd + rear_roll;
   resist_y += front_roll * sd;
-  const double front_roll_yaw = front_roll * sd * c.lf_m;
+  const double front_roll_yaw = front_roll * sd * lf_m;
 
   const double fx_body = ffx * cd - ffy * sd + frx + resist_x;
   const double fy_body = ffx * sd + ffy * cd + fry + resist_y;
@@ -146,7 +147,7 @@ CarState car_derivative(const CarConstants& c, const CarState& s, const CarInput
   ds[kYaw] = r;
   ds[kVx] = fx_body / m + in.gravity_x_mps2 + vy * r;
   ds[kVy] = fy_body / m + in.gravity_y_mps2 - vx * r;
-  ds[kR] = (c.lf_m * (ffy * cd + ffx * sd) - c.lr_m * fry + front_roll_yaw) / iz;
+  ds[kR] = (lf_m * (ffy * cd + ffx * sd) - lr_m * fry + front_roll_yaw) / iz;
   ds[kWf] = -ffx * c.wheel_radius_m / c.front_wheel_inertia_kgm2;
   ds[kWr] = (in.motor_torque_Nm - frx * c.wheel_radius_m) / c.rear_wheel_inertia_kgm2;
   return ds;

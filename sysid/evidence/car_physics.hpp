@@ -44,6 +44,7 @@ struct CarInputs {
   double extra_drag_kgpm = 0;    // aerodynamic drag -c |v| v along the velocity vector
   double front_rolling_coefficient = 0, rear_rolling_coefficient = 0;  // per axle, x its load
   double mass_scale = 1, yaw_inertia_scale = 1;  // payload
+  double cg_rearward_m = 0;      // the CG sits this much nearer the rear axle (l_f + d, l_r - d)
 };
 
 // Magic Formula friction coefficient at total slip s (before the grip scale), of the front tyre

@@ -163,6 +163,7 @@ EvidenceResult generate_evidence(const EvidenceOptions& o, const std::string& cs
       in.rear_rolling_coefficient = o.truth.rear_rolling_coefficient;
       in.mass_scale = o.truth.payload_mass_scale;
       in.yaw_inertia_scale = o.truth.payload_yaw_inertia_scale;
+      in.cg_rearward_m = o.truth.weight_shift * (car.lf_m + car.lr_m);
       s = rk4_step(car, s, in, dt);
       bool finite = true;
       for (double v : s) finite = finite && std::isfinite(v);

@@ -253,6 +253,26 @@ TEST_CASE("payload and motor speed equal the base model with its mass, inertia a
   CHECK(max_difference_after(SingleTrack(), CorrectedSingleTrack(SingleTrack(), e), u, u, 500) > 1e-2f);
 }
 
+TEST_CASE("a weight distribution is the base model with its CG moved along the wheelbase", "[effects]") {
+  const SingleTrackParams nominal;
+  const double wheelbase_m = nominal.cg_to_front_axle_m + nominal.cg_to_rear_axle_m;
+  const float u[2] = {0.3f, 0.5f};
+  for (const double s : {0.1, -0.05}) {
+    INFO("shift " << s);
+    EffectParams e;
+    e.cg_shift_rear = s;
+    SingleTrackParams moved = nominal;  // the oracle: the CG s L further back, the wheelbase kept
+    moved.cg_to_front_axle_m = nominal.cg_to_front_axle_m + s * wheelbase_m;
+    moved.cg_to_rear_axle_m = nominal.cg_to_rear_axle_m - s * wheelbase_m;
+    CHECK(max_difference_after(SingleTrack(moved), CorrectedSingleTrack(SingleTrack(), e), u, u, 500) < 1e-5f);
+    CHECK(max_difference_after(SingleTrack(), CorrectedSingleTrack(SingleTrack(), e), u, u, 500) > 1e-2f);
+  }
+  // Beyond an axle the car is not a car: refused with the reason.
+  EffectParams beyond;
+  beyond.cg_shift_rear = 0.9;
+  CHECK_THROWS_WITH(CorrectedSingleTrack(SingleTrack(), beyond), Catch::Contains("cg_to_rear_axle_m"));
+}
+
 TEST_CASE("a grip patch is the base model with the friction curve scaled on the patch only", "[effects]") {
   SingleTrackParams slippery;  // the friction curve (peak and vertical shift) x 0.5
   slippery.tyre.D *= 0.5;
@@ -316,35 +336,36 @@ TEST_CASE("a grip patch is the base model with the friction curve scaled on the 
 
 namespace {
 
-// Change of v_x over one step [m/s^2] of a car driven straight at speed v with the actuator
-// chains settled on throttle u.
-double one_step_accel(const CorrectedSingleTrack& m, float v_mps, float u_throttle) {
-  float x[CorrectedSingleTrack::kNx];
+// v_x [m/s] after driving straight for `seconds` at throttle u from speed v0 (wheels rolling),
+// the actuator chains settled on u.
+template <class M>
+double speed_after(const M& m, float v0_mps, float u_throttle, double seconds) {
+  std::vector<float> x(M::kNx, 0.f);
   VehicleState s;
-  s.vx_mps = v_mps;
-  m.init_state(s, x);
-  m.set_actuators(x, 0.f, u_throttle);
+  s.vx_mps = v0_mps;
+  m.init_state(s, x.data());
+  if constexpr (requires { M::set_actuators(x.data(), 0.f, 0.f); }) m.set_actuators(x.data(), 0.f, u_throttle);
   const float u[2] = {0.f, u_throttle};
-  const float dt = 0.001f;
-  m.step<1>(Batch<CorrectedSingleTrack::kNx, 1>{x}, ConstBatch<2, 1>{u}, dt, nullptr);
-  return (static_cast<double>(x[state::kVx]) - v_mps) / dt;
+  const float dt = 0.002f;
+  for (int i = 0; i < static_cast<int>(seconds / dt + 0.5); ++i)
+    m.template step<1>(Batch<M::kNx, 1>{x.data()}, ConstBatch<2, 1>{u}, dt, nullptr);
+  return x[state::kVx];
 }
 
 }  // namespace
 
 TEST_CASE("a freewheeling motor takes the share f (1 - |u|) of the back-EMF braking away", "[effects]") {
-  // Nominal drive force F_stall (u - v / v_nl) with F_stall = T_stall / R; with the share f of
-  // the back-EMF braking acting only while the PWM is on, F_stall (u - v / v_nl ((1 - f) + f |u|)):
-  // the difference f (1 - |u|) F_stall v / v_nl (f = 1: Liniger et al.'s (a - b v) u with
-  // b = a / v_nl, the law of the DART and ETH RC cars).
+  // Nominal drive torque T_stall (u - omega R / v_nl); with the share f of the back-EMF braking
+  // acting only while the PWM is on, T_stall (u - omega R / v_nl ((1 - f) + f |u|)) (f = 1:
+  // Liniger et al.'s (a - b v) u, the law of the DART and ETH RC cars). At a fixed command that is
+  // the base model with the no-load speed v_nl / ((1 - f) + f |u|) (oracle).
   SingleTrackParams p;
   p.stall_torque_Nm = 0.82;
   p.wheel_radius_m = 0.0325;
   p.no_load_speed_mps = 5.27;
   p.mass_kg = 1.58;
   p.yaw_inertia_kgm2 = 0.0048;
-  const double f_stall = p.stall_torque_Nm / p.wheel_radius_m;
-  const CorrectedSingleTrack nominal{SingleTrack(p)};
+  p.brake_torque_ratio = 0.5;
   for (const double f : {1.0, 0.4}) {
     EffectParams e;
     e.motor_freewheel_share = f;
@@ -353,23 +374,79 @@ TEST_CASE("a freewheeling motor takes the share f (1 - |u|) of the back-EMF brak
       for (const float u : {0.0f, 0.3f, -0.5f, 1.0f, 1.3f}) {
         INFO("f " << f << ", v " << v << " m/s, u " << u);
         const double duty = std::min(std::abs(static_cast<double>(u)), 1.0);
-        const double expected = f * (1 - duty) * f_stall * v / p.no_load_speed_mps / p.mass_kg;
-        CHECK(one_step_accel(freewheel, v, u) - one_step_accel(nominal, v, u) ==
-              Approx(expected).margin(0.002 * f_stall / p.mass_kg));
+        SingleTrackParams motor = p;
+        motor.no_load_speed_mps = (1 - f) + f * duty > 0 ? p.no_load_speed_mps / ((1 - f) + f * duty) : 1e7;
+        const double expected = speed_after(SingleTrack(motor), v, u, 0.5);
+        CHECK(speed_after(freewheel, v, u, 0.5) == Approx(expected).margin(2e-3));
+        if (duty < 1.0) CHECK(std::abs(expected - speed_after(SingleTrack(p), v, u, 0.5)) > 0.005);  // it matters
       }
     }
   }
-  // With a payload the force acts on the heavier car.
+  // With a payload the motor drives the heavier car.
   EffectParams heavy;
   heavy.motor_freewheel_share = 1.0;
   heavy.mass_scale = 2.0;
-  EffectParams heavy_nominal;
-  heavy_nominal.mass_scale = 2.0;
-  CHECK(one_step_accel(CorrectedSingleTrack{SingleTrack(p), heavy}, 2.f, 0.f) -
-            one_step_accel(CorrectedSingleTrack{SingleTrack(p), heavy_nominal}, 2.f, 0.f) ==
-        Approx(f_stall * 2.0 / p.no_load_speed_mps / (2 * p.mass_kg)).margin(0.002 * f_stall / p.mass_kg));
+  SingleTrackParams heavy_motor = p;
+  heavy_motor.mass_kg *= 2.0;
+  heavy_motor.no_load_speed_mps = 1e7;  // no back-EMF braking at neutral
+  CHECK(speed_after(CorrectedSingleTrack{SingleTrack(p), heavy}, 2.f, 0.f, 0.5) ==
+        Approx(speed_after(SingleTrack(heavy_motor), 2.f, 0.f, 0.5)).margin(2e-3));
   // Refused where the base has no motor of its own.
   EffectParams full;
   full.motor_freewheel_share = 1.0;
   CHECK_THROWS_AS(KinematicWithEffects(KinematicBicycle(), full), Error);
+}
+
+TEST_CASE("a drag brake decelerates the car by a_db at neutral command, and only there", "[effects]") {
+  SingleTrackParams p;  // the AutoRally car, without the resistances the closed forms leave out
+  p.rolling_resistance = 0.0;
+  p.aero_drag_kgpm = 0.0;
+  p.brake_torque_ratio = 0.4;
+  SingleTrackParams no_emf = p;  // a motor without back-EMF: coasting keeps the speed
+  no_emf.no_load_speed_mps = 1e7;
+  // The brake torque m R a_db decelerates the car and its wheels (m_eff = m + (I_f + I_r) / R^2)
+  // by a_db m / m_eff: a straight line while v >> 0.5 m/s (within 4 %: the tyres slip while they
+  // brake, which the closed form leaves out).
+  const double m_eff = p.mass_kg + (p.front_wheel_inertia_kgm2 + p.rear_wheel_inertia_kgm2) / (p.wheel_radius_m * p.wheel_radius_m);
+  const double drop_mps = 2.0 * p.mass_kg / m_eff;  // a_db = 2 m/s^2 for 1 s
+  EffectParams brake;
+  brake.drag_brake_mps2 = 2.0;
+  const CorrectedSingleTrack braked{SingleTrack(no_emf), brake};
+  const CorrectedSingleTrack plain{SingleTrack(no_emf)};
+  CHECK(5.0 - speed_after(plain, 5.f, 0.f, 1.0) == Approx(0.0).margin(0.01));
+  CHECK(5.0 - speed_after(braked, 5.f, 0.f, 1.0) == Approx(drop_mps).epsilon(0.04));
+  // Within 0.05 of neutral the whole brake acts, on top of the drive; halfway through the band's
+  // edge (|u| 0.05 -> 0.1) half of it; beyond it none.
+  CHECK(speed_after(plain, 5.f, 0.03f, 1.0) - speed_after(braked, 5.f, 0.03f, 1.0) == Approx(drop_mps).epsilon(0.04));
+  CHECK(speed_after(plain, 5.f, 0.075f, 1.0) - speed_after(braked, 5.f, 0.075f, 1.0) ==
+        Approx(0.5 * drop_mps).epsilon(0.04));
+  CHECK(speed_after(braked, 5.f, 0.3f, 1.0) == Approx(speed_after(plain, 5.f, 0.3f, 1.0)).margin(1e-4));
+  CHECK(speed_after(braked, 5.f, -0.3f, 1.0) == Approx(speed_after(plain, 5.f, -0.3f, 1.0)).margin(1e-4));
+  // Reversing, it brakes the other way.
+  CHECK(speed_after(braked, -4.f, 0.f, 1.0) + 4.0 == Approx(drop_mps).epsilon(0.04));
+  // With the motor freewheeling at neutral (motor_freewheel f = 1: no back-EMF braking there) the
+  // drag brake is all that slows the coasting car: a PWM ESC's neutral in drive-brake mode.
+  // A 1:10 RC car (data/config/eth_rccar_single_track.yaml, a weaker motor: its back-EMF braking
+  // within the rear tyre's grip, as motor_freewheel's body force needs), whose wheels are light.
+  SingleTrackParams rc = p;
+  rc.mass_kg = 1.65;
+  rc.yaw_inertia_kgm2 = 0.0155;
+  rc.cg_to_front_axle_m = 0.13;
+  rc.cg_to_rear_axle_m = 0.17;
+  rc.cg_height_m = 0.03;
+  rc.wheel_radius_m = 0.0325;
+  rc.front_wheel_inertia_kgm2 = rc.rear_wheel_inertia_kgm2 = 5e-5;
+  rc.stall_torque_Nm = 0.3;
+  rc.no_load_speed_mps = 6.0;
+  const double rc_drop_mps = 1.0 * 0.5 * rc.mass_kg / (rc.mass_kg + 2 * 5e-5 / (0.0325 * 0.0325));  // 0.5 s
+  EffectParams esc;
+  esc.drag_brake_mps2 = 1.0;
+  esc.motor_freewheel_share = 1.0;
+  CHECK(2.5 - speed_after(CorrectedSingleTrack{SingleTrack(rc), esc}, 2.5f, 0.f, 0.5) == Approx(rc_drop_mps).epsilon(0.06));
+  CHECK(2.5 - speed_after(CorrectedSingleTrack{SingleTrack(rc)}, 2.5f, 0.f, 0.5) > 1.5 * rc_drop_mps);  // back-EMF
+  // Refused where the base has no motor of its own; a negative brake refused by name.
+  CHECK_THROWS_AS(KinematicWithEffects(KinematicBicycle(), brake), Error);
+  EffectParams bad;
+  bad.drag_brake_mps2 = -1.0;
+  CHECK_THROWS_WITH(CorrectedSingleTrack(SingleTrack(p), bad), Catch::Contains("drag_brake_mps2"));
 }

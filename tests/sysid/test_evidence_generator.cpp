@@ -161,6 +161,36 @@ TEST_CASE("evidence: drag along the velocity vector is -c |v| v and a coasting c
   CHECK(d2 / d1 == Approx(4.0).epsilon(1e-9));
 }
 
+TEST_CASE("evidence: a weight shift moves the static axle loads to m g (l_r - d) / L and the lever arms with them", "[evidence]") {
+  const CarConstants c = frictionless_straight();
+  const double wheelbase_m = c.lf_m + c.lr_m, weight_N = c.mass_kg * c.gravity_mps2;
+  for (const double d : {0.0, 0.05, -0.04}) {
+    INFO("d " << d << " m");
+    CarInputs in;
+    in.cg_rearward_m = d;
+    CarForces f;
+    car_derivative(c, rolling(3.0, c), in, &f);  // rolling straight: no friction, no pitch transfer
+    CHECK(f.front.fz_N == Approx(weight_N * (c.lr_m - d) / wheelbase_m).epsilon(1e-9));
+    CHECK(f.rear.fz_N == Approx(weight_N * (c.lf_m + d) / wheelbase_m).epsilon(1e-9));
+  }
+  // Turning at a steady wheel angle and side slip: the yaw moment's lever arms are l_f + d, l_r - d.
+  CarState s = rolling(5.0, c);
+  s[kVy] = 0.3;
+  s[kR] = 0.4;
+  CarInputs shifted;
+  shifted.wheel_angle_rad = 0.1;
+  shifted.cg_rearward_m = 0.05;
+  CarForces f;
+  const CarState ds = car_derivative(c, s, shifted, &f);
+  const double lf = c.lf_m + 0.05, lr = c.lr_m - 0.05;
+  // The rear tyre's side force at the rear contact: v_y - l_r r (the lever arm moved with the CG).
+  const double cd = std::cos(0.1), sd = std::sin(0.1);
+  CHECK(ds[kR] == Approx((lf * (f.front.fy_N * cd + f.front.fx_N * sd) - lr * f.rear.fy_N) / c.yaw_inertia_kgm2).epsilon(1e-9));
+  CarInputs unshifted = shifted;
+  unshifted.cg_rearward_m = 0;
+  CHECK(std::abs(car_derivative(c, s, unshifted)[kR] - ds[kR]) > 0.1);
+}
+
 TEST_CASE("evidence: a grade adds -g sin(theta) along the slope and nothing across it", "[evidence]") {
   const CarConstants c = frictionless_straight();
   const double grade = 0.08, theta = std::atan(grade);
