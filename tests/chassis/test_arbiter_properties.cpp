@@ -224,7 +224,7 @@ TEST_CASE("arbiter, runstop and watchdog agree with the reference model on rando
   CHECK(rejected_seen > 1000);
 }
 
-TEST_CASE("no runstop message means stopped; one stale source does not stop the others",
+TEST_CASE("no runstop message means stopped, one stale source does not stop the others",
           "[chassis]") {
   Arbiter a(Priorities({{"mppi", 1}}));
   FakeClock clock;

@@ -106,7 +106,7 @@ TEST_CASE("AutoRally's calibration files load, bad ones are named", "[chassis][c
              Catch::Contains("'reverse' must be true or false"));
 }
 
-TEST_CASE("AutoRally's priority file loads best first; ties and junk are rejected",
+TEST_CASE("AutoRally's priority file loads best first, ties and junk are rejected",
           "[chassis][priorities]") {
   const auto p = Priorities::parse_yaml(
       "'imlearn': 0\n'mppi_controller': 1\n'constantSpeedController': 2\n'waypointFollower': 3\n"

@@ -395,7 +395,7 @@ TEST_CASE("track cfg: quotes, spacing, key order and decoy keys", "[costs]") {
   CHECK_THAT(msg, Catch::Contains("in memory: missing key 'yBounds'"));
 }
 
-TEST_CASE("CostMap: image bytes in memory decode as the file does; bad bytes name the source", "[costs]") {
+TEST_CASE("CostMap: image bytes in memory decode as the file does, bad bytes name the source", "[costs]") {
   const std::string dir = mppi::test::data_path("autorally/maps/gazebo/");
   const mppi::ImageMapSpec spec = mppi::CostMap::read_autorally_track_cfg(dir + "gazebo_track.cfg");
   std::ifstream in(dir + "gazebo_map.png", std::ios::binary);

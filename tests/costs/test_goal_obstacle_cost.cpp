@@ -121,7 +121,7 @@ TEST_CASE("GoalObstacleCost other settings: powers, repulsion near the goal, let
   }
 }
 
-TEST_CASE("GoalObstacleCost: NaN state costs +inf; bad settings throw", "[goalcost]") {
+TEST_CASE("GoalObstacleCost: NaN state costs +inf, bad settings throw", "[goalcost]") {
   const GoalObstacleCost cost(bench_map());
   const float s[3] = {NAN, 1.f, 0.f};
   CHECK(cost.evaluate(s) == std::numeric_limits<float>::infinity());

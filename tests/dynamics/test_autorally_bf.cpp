@@ -143,7 +143,7 @@ TEST_CASE("autorally-bf: one step equals a naive double evaluation of the 25 bas
   CHECK(worst < 2e-6);  // float rounding of a 0.02 s step (measured 2.8e-7)
 }
 
-TEST_CASE("autorally-bf: the shipped weights load; bad files are refused with the reason", "[autorally_bf]") {
+TEST_CASE("autorally-bf: the shipped weights load, bad files are refused with the reason", "[autorally_bf]") {
   const auto model = mppi::AutoRallyBasisFunctionModel::load(data(kWeights));
   CHECK(model.weights()[0] == Approx(-0.006).margin(1e-3));  // W[0][0], roll row, throttle
   CHECK_THROWS_WITH(mppi::AutoRallyBasisFunctionModel::load(data("autorally/models/autorally_nnet_09_12_2018.npz")),

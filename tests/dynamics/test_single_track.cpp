@@ -242,7 +242,7 @@ TEST_CASE("Single-track batched step<64> equals the scalar step and Euler in dou
   }
 }
 
-TEST_CASE("Single-track straight line stays straight; steering is mirror-symmetric",
+TEST_CASE("Single-track straight line stays straight, steering is mirror-symmetric",
           "[physics][single_track]") {
   const SingleTrack model;
   // Straight: steer 0, no lateral velocity or yaw rate -> no lateral force, exactly.

@@ -174,7 +174,7 @@ static void check_other_nominal(const char* model, const char* truth_text) {
   }
 }
 
-TEST_CASE("diagnosis from a double-track nominal names a steering delay; nothing on a clean recording",
+TEST_CASE("diagnosis from a double-track nominal names a steering delay, nothing on a clean recording",
           "[diagnose][other_models]") {
   check_other_nominal("double-track", "steer_delay_s=0.08");
   check_other_nominal("double-track", "");

@@ -86,7 +86,7 @@ TEST_CASE("seed x effect sweep: a steering offset is named alone and held-out er
   check_named_alone("steer_offset=0.08");
 }
 
-TEST_CASE("two hidden effects at once are both named; report and model file agree", "[diagnose]") {
+TEST_CASE("two hidden effects at once are both named, report and model file agree", "[diagnose]") {
   const auto dir = std::filesystem::temp_directory_path() / "mppi_test_diagnose_two";
   std::filesystem::remove_all(dir);
   std::vector<std::string> ids;
@@ -112,7 +112,7 @@ TEST_CASE("two hidden effects at once are both named; report and model file agre
   std::size_t library_rows = 0, joint_rows = 0;
   for (const auto& e : j["effects"]) (e.contains("joint_of") ? joint_rows : library_rows)++;
   CHECK(library_rows == effect_library().size());
-  CHECK(joint_rows == 2);
+  CHECK(joint_rows == 3);  // steering gain+offset, throttle gain+offset, freewheel+drag brake
   CHECK(!j["mismatch"].empty());
   const CorrectedModelFile f = load_corrected_model(j["model_file"].get<std::string>());
   CHECK(f.effects.steer_delay_s == Approx(0.08).margin(0.01));

@@ -66,7 +66,7 @@ TEST_CASE("Protocol: replaying the commands through the model reproduces the tru
   CHECK(worst_v < 0.02);  // float plant vs double replay
 }
 
-TEST_CASE("Protocol: sensor noise has the configured statistics; commands are exact",
+TEST_CASE("Protocol: sensor noise has the configured statistics, commands are exact",
           "[sysid][protocol]") {
   const sysid::ProtocolOptions o;
   const sysid::ProtocolRun run = sysid::run_protocol(FullVehicleParams{}, o);
@@ -85,7 +85,7 @@ TEST_CASE("Protocol: sensor noise has the configured statistics; commands are ex
   CHECK(steer.mean == 0.0);
 }
 
-TEST_CASE("Protocol layouts: 20 s of each manoeuvre; interleaved has all five in every 20 s",
+TEST_CASE("Protocol layouts: 20 s of each manoeuvre, interleaved has all five in every 20 s",
           "[sysid][protocol]") {
   // Oracle: count 50 Hz samples per manoeuvre over the 100 s, and which manoeuvres occur in
   // each 20 s window; the pattern clock must advance with the manoeuvre's own samples.
