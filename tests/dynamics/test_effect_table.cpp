@@ -426,8 +426,8 @@ TEST_CASE("a drag brake decelerates the car by a_db at neutral command, and only
   CHECK(speed_after(braked, -4.f, 0.f, 1.0) + 4.0 == Approx(drop_mps).epsilon(0.04));
   // With the motor freewheeling at neutral (motor_freewheel f = 1: no back-EMF braking there) the
   // drag brake is all that slows the coasting car: a PWM ESC's neutral in drive-brake mode.
-  // A 1:10 RC car (data/config/eth_rccar_single_track.yaml, a weaker motor: its back-EMF braking
-  // within the rear tyre's grip, as motor_freewheel's body force needs), whose wheels are light.
+  // A 1:10 RC car (data/config/eth_rccar_single_track.yaml, with a weaker motor, so its back-EMF
+  // braking stays within the rear tyre's grip and the closed form holds), whose wheels are light.
   SingleTrackParams rc = p;
   rc.mass_kg = 1.65;
   rc.yaw_inertia_kgm2 = 0.0155;
