@@ -30,6 +30,10 @@
 //             load_transfer               CG height h -> h + dh (pitch load transfer)
 //             weight_distribution         the CG sits s of the wheelbase L further back: l_f + s L,
 //                                         l_r - s L (the axles' static loads; s < 0: forward)
+//             drive_split                 a share d of the motor's torque moves to the front
+//                                         axle (front_drive_share + d, kept in [0, 1]): a
+//                                         four-wheel-drive car modelled as rear-wheel drive
+//                                         (single-track core only)
 //             payload                     mass x m, yaw inertia x j
 //             motor_speed                 no-load speed x v (the motor's torque-speed line)
 //             motor_freewheel             share f of the drive's back-EMF braking that acts only
@@ -63,6 +67,7 @@
 //             ground_bump                 a hill (h > 0) or dip (h < 0) at a place: z = h (1 + cos(pi d /
 //                                         R)) / 2 within R of its centre, 0 beyond: -m g grad z
 // Every effect is off at its default value.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -91,6 +96,7 @@ struct EffectParams {
   double grip_change_time_s = 0.0;   // [s] time of the grip change (time is a state)
   double cg_height_delta_m = 0.0;    // [m] dh added to the CG height
   double cg_shift_rear = 0.0;        // [-] s: the CG moves s x wheelbase towards the rear axle
+  double front_drive_shift = 0.0;    // [-] d: share of the motor torque moved to the front axle
   double voltage_sag = 0.0;          // [-] k in u - k max(u,0)^2
   double grade_x = 0.0;              // [-] slope dz/dx of the ground plane
   double grade_y = 0.0;              // [-] slope dz/dy of the ground plane
@@ -236,6 +242,9 @@ inline const std::vector<EffectSpec>& effect_table() {
       {"weight_distribution", "the CG sits elsewhere along the wheelbase: l_f + s L, l_r - s L (s > 0: rearward)", H::kChassis,
        {{"cg_shift_rear", &E::cg_shift_rear, "1 (of the wheelbase)", open(-1.0, 1.0), -0.4, 0.4, 0.02}}, {-0.1, 0.1},
        DataGrid::kNone, X::kAny},
+      {"drive_split", "a share d of the drive and brake torque acts on the front axle (four-wheel drive)", H::kChassis,
+       {{"front_drive_shift", &E::front_drive_shift, "1 (of the motor torque)", closed(-1.0, 1.0), 0.0, 1.0, 0.05}},
+       {0.3, 0.6}, DataGrid::kNone, X::kThrottle},
       {"motor_voltage_sag", "drive falls with current: throttle u - k max(u,0)^2", H::kActuator,
        {{"voltage_sag", &E::voltage_sag, "1", {0.0, 1.0, Bounds::kOpenHigh}, 0.0, 0.9, 0.05}}, {}, DataGrid::kNone, X::kThrottle},
       {"road_grade", "tilted ground plane z = gx x + gy y", H::kForce,
@@ -341,6 +350,7 @@ inline SingleTrackParams apply_effect_params(SingleTrackParams p, const EffectPa
   const double wheelbase_m = p.cg_to_front_axle_m + p.cg_to_rear_axle_m;
   p.cg_to_front_axle_m += e.cg_shift_rear * wheelbase_m;
   p.cg_to_rear_axle_m -= e.cg_shift_rear * wheelbase_m;
+  p.front_drive_share = std::min(std::max(p.front_drive_share + e.front_drive_shift, 0.0), 1.0);
   p.mass_kg *= e.mass_scale;
   p.yaw_inertia_kgm2 *= e.yaw_inertia_scale;
   p.no_load_speed_mps *= e.motor_speed_scale;

@@ -7,8 +7,10 @@
 //   dVx = (fFx cos d - fFy sin d + fRx + F_res) / m + Vy r
 //   dVy = (fFx sin d + fFy cos d + fRy) / m - Vx r
 //   dr  = ((fFy cos d + fFx sin d) l_f - fRy l_r) / I_z
-//   I_f domega_f = -fFx R,   I_r domega_r = T_rear - fRx R
-// T_rear = T_stall (max(u, 0) + k_brake min(u, 0) - omega_r R / v_no_load) (vehicle_params.hpp).
+//   I_f domega_f = s T - fFx R,   I_r domega_r = (1 - s) T - fRx R
+// T = T_stall (max(u, 0) + k_brake min(u, 0) - omega_m R / v_no_load) (vehicle_params.hpp), with s
+// the front axle's share of the drive (front_drive_share; 0 = rear-wheel drive, the paper's car)
+// and omega_m = s omega_f + (1 - s) omega_r the motor's wheel-equivalent speed.
 // Tyre-frame velocities: front (Vx cos d + (Vy + r l_f) sin d, -Vx sin d + (Vy + r l_f) cos d),
 // rear (Vx, Vy - r l_r); friction from dynamics/pacejka.hpp (the rear tyre's B, C, D scaled by
 // rear_tyre_*_scale); normal loads from Velenis'
@@ -39,6 +41,7 @@ struct SingleTrackCoeffs {
   T weight;  // m g [N]
   T max_steer, stall_torque, brake_ratio, inv_no_load_speed, rolling_force, inv_rolling_speed, drag;
   T slip_floor, inv_slip_blend;
+  T front_drive, rear_drive;   // shares of the motor torque (sum 1)
   PacejkaCoeffs<T> tyre;       // front axle
   PacejkaCoeffs<T> rear_tyre;  // rear axle (SingleTrackParams::rear_tyre())
 
@@ -50,7 +53,8 @@ struct SingleTrackCoeffs {
             t(p.mass_kg * p.gravity_mps2), t(p.max_steer_rad), t(p.stall_torque_Nm), t(p.brake_torque_ratio),
             t(1 / p.no_load_speed_mps), t(p.rolling_resistance * p.mass_kg * p.gravity_mps2),
             t(1 / p.rolling_resistance_speed_mps), t(p.aero_drag_kgpm), t(p.slip_speed_floor_mps),
-            t(1 / p.slip_blend), PacejkaCoeffs<T>::from(p.tyre),
+            t(1 / p.slip_blend), t(p.front_drive_share), t(1 - p.front_drive_share),
+            PacejkaCoeffs<T>::from(p.tyre),
             PacejkaCoeffs<T>::from(p.rear_tyre())};
   }
 };
@@ -66,7 +70,7 @@ struct SingleTrackTerms {
   T front_fz_N, rear_fz_N;            // normal loads
   T front_fx_N, front_fy_N;           // front friction force, tyre frame
   T rear_fx_N, rear_fy_N;             // rear friction force, tyre frame (= body frame)
-  T drive_torque_Nm;                  // motor torque at the rear axle
+  T drive_torque_Nm;                  // motor torque (both axles together)
   T resist_force_N;                   // rolling resistance + drag along body x (negative = retarding)
   T dvx_mps2, dvy_mps2, dyaw_rate_radps2, domega_front_radps2, domega_rear_radps2;
 };
@@ -97,8 +101,9 @@ inline void single_track_terms(const SingleTrackCoeffs<T>& k, T vx, T vy, T r, T
   e->front_fy_N = e->front.mu_y * e->front_fz_N;
   e->rear_fx_N = e->rear.mu_x * e->rear_fz_N;
   e->rear_fy_N = e->rear.mu_y * e->rear_fz_N;
+  const T motor_omega = k.front_drive * omega_f + k.rear_drive * omega_r;
   e->drive_torque_Nm = k.stall_torque * (std::max(throttle, T(0)) + k.brake_ratio * std::min(throttle, T(0)) -
-                                         omega_r * k.radius * k.inv_no_load_speed);
+                                         motor_omega * k.radius * k.inv_no_load_speed);
   e->resist_force_N = -k.rolling_force * phys::tanh(vx * k.inv_rolling_speed) - k.drag * vx * std::abs(vx);
   const T body_fx = e->front_fx_N * cd - e->front_fy_N * sd + e->rear_fx_N;  // body x
   const T body_fy = e->front_fx_N * sd + e->front_fy_N * cd + e->rear_fy_N;  // body y
@@ -106,8 +111,8 @@ inline void single_track_terms(const SingleTrackCoeffs<T>& k, T vx, T vy, T r, T
   e->dvy_mps2 = body_fy * k.inv_mass - vx * r;
   e->dyaw_rate_radps2 =
       ((e->front_fy_N * cd + e->front_fx_N * sd) * k.lf - e->rear_fy_N * k.lr) * k.inv_yaw_inertia;
-  e->domega_front_radps2 = -e->front_fx_N * k.radius * k.inv_front_inertia;
-  e->domega_rear_radps2 = (e->drive_torque_Nm - e->rear_fx_N * k.radius) * k.inv_rear_inertia;
+  e->domega_front_radps2 = (k.front_drive * e->drive_torque_Nm - e->front_fx_N * k.radius) * k.inv_front_inertia;
+  e->domega_rear_radps2 = (k.rear_drive * e->drive_torque_Nm - e->rear_fx_N * k.radius) * k.inv_rear_inertia;
 }
 
 class SingleTrack {

@@ -6,6 +6,7 @@
 // plausible for a 22 kg 1:5 rally car and are meant to be calibrated.
 #include <cmath>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "dynamics/pacejka.hpp"
@@ -55,6 +56,10 @@ struct SingleTrackParams {
   double rear_tyre_B_scale = 1.0;         // rear stiffness factor / front [-]
   double rear_tyre_C_scale = 1.0;         // rear shape factor / front [-]
   double rear_tyre_D_scale = 1.0;         // rear peak factor / front [-]
+  // Drive layout: the share of the motor's torque (drive and brake) that reaches the front
+  // axle; 0 = rear-wheel drive (AutoRally), 0.5 = four-wheel drive with an even split. The motor
+  // turns at the shares' mean of the axles' wheel speeds (a differential between the axles).
+  double front_drive_share = 0.0;         // front axle's share of the motor torque [-]
 
   double wheelbase_m() const { return cg_to_front_axle_m + cg_to_rear_axle_m; }
   // The rear axle's tyre: `tyre` with the rear scales applied.
@@ -215,9 +220,19 @@ inline std::vector<ParamField> param_table(SingleTrackParams& p, bool with_aero_
       param("rear_tyre_B_scale", &p.rear_tyre_B_scale, "-", positive(), "rear tyre stiffness factor B / front B"),
       param("rear_tyre_C_scale", &p.rear_tyre_C_scale, "-", positive(), "rear tyre shape factor C / front C"),
       param("rear_tyre_D_scale", &p.rear_tyre_D_scale, "-", positive(), "rear tyre peak factor D / front D"),
+      param("front_drive_share", &p.front_drive_share, "-", closed(0, 1),
+            "share of the motor torque on the front axle (0 rear-wheel drive, 0.5 even four-wheel drive)"),
   };
   if (!with_aero_drag) f.erase(f.begin() + 15);  // aero_drag_kgpm
   for (const ParamField& t : param_table(p.tyre)) f.push_back(t);
+  return f;
+}
+
+// The single-track keys of a four-wheel model's base: those models drive the rear axle only, so
+// front_drive_share is not among their keys (their is_valid refuses a value other than 0).
+inline std::vector<ParamField> rear_drive_param_table(SingleTrackParams& p, bool with_aero_drag = true) {
+  std::vector<ParamField> f = param_table(p, with_aero_drag);
+  std::erase_if(f, [](const ParamField& q) { return std::string_view(q.key) == "front_drive_share"; });
   return f;
 }
 
@@ -231,7 +246,7 @@ inline std::vector<ParamField> param_table(KinematicBicycleParams& p) {
 }
 
 inline std::vector<ParamField> param_table(DoubleTrackParams& p) {
-  std::vector<ParamField> f = param_table(p.base);
+  std::vector<ParamField> f = rear_drive_param_table(p.base);
   f.insert(f.end() - 6,  // before the tyre map
            {param("front_track_m", &p.front_track_m, "m", positive(), "front track width w_f"),
             param("rear_track_m", &p.rear_track_m, "m", positive(), "rear track width w_r"),
@@ -243,7 +258,7 @@ inline std::vector<ParamField> param_table(DoubleTrackParams& p) {
 }
 
 inline std::vector<ParamField> param_table(FullVehicleParams& p) {
-  std::vector<ParamField> f = param_table(p.base, /*with_aero_drag=*/false);
+  std::vector<ParamField> f = rear_drive_param_table(p.base, /*with_aero_drag=*/false);
   f.insert(f.end() - 6,
            {param("front_track_m", &p.front_track_m, "m", positive(), "front track width w_f"),
             param("rear_track_m", &p.rear_track_m, "m", positive(), "rear track width w_r"),
@@ -286,6 +301,10 @@ inline bool SingleTrackParams::is_valid(std::string* why) const {
 
 inline bool DoubleTrackParams::is_valid(std::string* why) const {
   if (!base.is_valid(why)) return false;
+  if (base.front_drive_share != 0) {
+    if (why) *why = "front_drive_share must be 0 for the double-track model (it drives the rear axle only)";
+    return false;
+  }
   DoubleTrackParams copy = *this;
   if (const std::string e = first_range_error(param_table(copy)); !e.empty()) {
     if (why) *why = e;
@@ -311,6 +330,8 @@ inline bool FullVehicleParams::is_valid(std::string* why) const {
     return false;
   };
   if (!base.is_valid(why)) return false;
+  if (base.front_drive_share != 0)
+    return fail("front_drive_share must be 0 for the full vehicle (it drives the rear axle only)");
   if (base.aero_drag_kgpm != 0)
     return fail("aero_drag_kgpm must be 0 for the full vehicle (drag is drag_coefficient, "
                 "air_density_kgpm3, frontal_area_m2)");

@@ -97,6 +97,7 @@ class WithEffects {
       brake_ratio_ = static_cast<float>(car.brake_torque_ratio);
       inv_brake_ratio_ = car.brake_torque_ratio > 0.0 ? static_cast<float>(1.0 / car.brake_torque_ratio) : 0.f;
       wheel_radius_ = static_cast<float>(car.wheel_radius_m);
+      front_drive_ = static_cast<float>(car.front_drive_share);
     }
     grade_x_ = static_cast<float>(g * effects_.grade_x);
     grade_y_ = static_cast<float>(g * effects_.grade_y);
@@ -170,7 +171,7 @@ class WithEffects {
   // motor_freewheel and drag_brake: the command u' that makes the base's motor law
   // T_stall (max(u', 0) + k_brake min(u', 0) - v / v_nl) give the ESC's torque
   //   T_stall (max(u, 0) + k_brake min(u, 0) - v / v_nl ((1 - f) + f |u|)) - m R a_db n(u) tanh(2 v),
-  // n = 1 in the ESC's neutral band; v is the driven wheels' rim speed omega_r R, as in the base's
+  // n = 1 in the ESC's neutral band; v is the motor's rim speed (motor_rim_speed), as in the base's
   // law. So the tyres still limit the torque. A base without a brake (k_brake = 0) cannot brake:
   // the negative part is dropped.
   float esc_throttle(float u, float rim_mps) const noexcept {
@@ -181,11 +182,12 @@ class WithEffects {
                     drag_brake_cmd_ * neutral * phys::tanh(rim_mps * 2.f);
     return g >= 0.f ? g : g * inv_brake_ratio_;
   }
-  // The driven (rear) wheels' rim speed omega_r R of lane j, as the base's motor sees it.
+  // The driven wheels' rim speed of lane j as the base's motor sees it: omega_r R, or with a
+  // share s of the drive on the front axle (s omega_f + (1 - s) omega_r) R.
   template <int W>
-  float rear_rim_speed(Batch<kNx, W> x, int j) const noexcept {
+  float motor_rim_speed(Batch<kNx, W> x, int j) const noexcept {
     if constexpr (requires { Base::kOmegaRear; }) {
-      return x[Base::kOmegaRear][j] * wheel_radius_;
+      return (front_drive_ * x[Base::kOmegaFront][j] + (1.f - front_drive_) * x[Base::kOmegaRear][j]) * wheel_radius_;
     } else if constexpr (kOmega >= 0) {  // four wheels: the differential carrier's speed
       return 0.5f * (x[kOmega + wheel::kLR][j] + x[kOmega + wheel::kRR][j]) * wheel_radius_;
     } else {
@@ -217,7 +219,7 @@ class WithEffects {
       const float vx = x[state::kVx][j];
       float sy, cy;
       fast_sincos(x[state::kYaw][j], &sy, &cy);
-      if (esc_) applied[control::kThrottle * W + j] = esc_throttle(applied[control::kThrottle * W + j], rear_rim_speed<W>(x, j));
+      if (esc_) applied[control::kThrottle * W + j] = esc_throttle(applied[control::kThrottle * W + j], motor_rim_speed<W>(x, j));
       float gx = grade_x_, gy = grade_y_;  // g x the ground's slope here (plane + bump)
       if (bump_) add_bump_slope(x[state::kX][j], x[state::kY][j], &gx, &gy);
       ax[j] = -drag_per_kg_ * vx * std::abs(vx) - roll_per_kg_ * phys::tanh(vx * 2.f) - visc_per_kg_ * vx -
@@ -348,6 +350,7 @@ class WithEffects {
   float throttle_gain_ = 1, thr_offset_ = 0, sag_ = 0;                              // throttle map
   bool esc_ = false;  // motor_freewheel, drag_brake
   float freewheel_per_mps_ = 0, drag_brake_cmd_ = 0, brake_ratio_ = 1, inv_brake_ratio_ = 1, wheel_radius_ = 1;
+  float front_drive_ = 0;  // the base's share of the drive on the front axle (after the effects)
 };
 
 using CorrectedSingleTrack = WithEffects<SingleTrack>;

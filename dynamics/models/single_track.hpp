@@ -61,6 +61,8 @@ struct SingleTrackModel {
             MPPI_COEFF("K_DRAG", drag),
             MPPI_COEFF("K_SLIP_FLOOR", slip_floor),
             MPPI_COEFF("K_INV_SLIP_BLEND", inv_slip_blend),
+            MPPI_COEFF("K_FRONT_DRIVE", front_drive),
+            MPPI_COEFF("K_REAR_DRIVE", rear_drive),
             MPPI_COEFF("K_B", tyre.B),
             MPPI_COEFF("K_C", tyre.C),
             MPPI_COEFF("K_D", tyre.D),

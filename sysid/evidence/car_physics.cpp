@@ -51,6 +51,7 @@ CarConstants read_car_constants(const std::string& yaml_path) {
       {"rear_tyre_B_scale", &c.rear_B_factor},
       {"rear_tyre_C_scale", &c.rear_C_factor},
       {"rear_tyre_D_scale", &c.rear_D_factor},
+      {"front_drive_share", &c.front_torque_share},
   };
   const std::vector<std::pair<const char*, double*>> tyre = {
       {"B", &c.mf_B}, {"C", &c.mf_C}, {"D", &c.mf_D}, {"E", &c.mf_E}, {"Sh", &c.mf_Sh}, {"Sv", &c.mf_Sv},
@@ -102,6 +103,8 @@ void tyre_coefficients(const CarConstants& c, bool rear, double vx, double vy, d
 
 }  // namespace
 
+double motor_wheel_speed(const CarState& s, double front) { return front * s[kWf] + (1 - front) * s[kWr]; }
+
 CarState car_derivative(const CarConstants& c, const CarState& s, const CarInputs& in, CarForces* forces) {
   const double m = c.mass_kg * in.mass_scale, iz = c.yaw_inertia_kgm2 * in.yaw_inertia_scale;
   const double weight = m * c.gravity_mps2;
@@ -148,8 +151,9 @@ CarState car_derivative(const CarConstants& c, const CarState& s, const CarInput
   ds[kVx] = fx_body / m + in.gravity_x_mps2 + vy * r;
   ds[kVy] = fy_body / m + in.gravity_y_mps2 - vx * r;
   ds[kR] = (lf_m * (ffy * cd + ffx * sd) - lr_m * fry + front_roll_yaw) / iz;
-  ds[kWf] = -ffx * c.wheel_radius_m / c.front_wheel_inertia_kgm2;
-  ds[kWr] = (in.motor_torque_Nm - frx * c.wheel_radius_m) / c.rear_wheel_inertia_kgm2;
+  const double front_torque = in.front_torque_share * in.motor_torque_Nm;
+  ds[kWf] = (front_torque - ffx * c.wheel_radius_m) / c.front_wheel_inertia_kgm2;
+  ds[kWr] = (in.motor_torque_Nm - front_torque - frx * c.wheel_radius_m) / c.rear_wheel_inertia_kgm2;
   return ds;
 }
 

@@ -22,6 +22,7 @@ struct CarConstants {
   double slip_floor_mps = 3.0, slip_blend = 0.1;
   // the rear tyre's B, C and D as multiples of the front's (E, Sh and Sv are shared)
   double rear_B_factor = 1.0, rear_C_factor = 1.0, rear_D_factor = 1.0;
+  double front_torque_share = 0.0;  // the motor torque's share on the front axle (0: rear-wheel drive)
 };
 
 // Reads a single-track vehicle YAML (yaml-cpp); keys not given keep the defaults. Throws
@@ -37,7 +38,8 @@ enum CarIndex { kX, kY, kYaw, kVx, kVy, kR, kWf, kWr };
 // What acts on the car during one integration step besides its wheel angle and motor torque.
 struct CarInputs {
   double wheel_angle_rad = 0;    // front wheel angle after the steering chain
-  double motor_torque_Nm = 0;    // rear axle torque
+  double motor_torque_Nm = 0;    // the motor's torque at the wheels (both axles together)
+  double front_torque_share = 0; // the part of it that an open centre differential sends to the front axle
   double grip_scale = 1;         // tyre friction x this (the surface under the car)
   double gravity_x_mps2 = 0;     // tangential gravity along body x, y (the grade)
   double gravity_y_mps2 = 0;
@@ -58,6 +60,10 @@ struct AxleForces {
 struct CarForces {
   AxleForces front, rear;
 };
+
+// The wheel-equivalent speed [rad/s] of the motor behind an open centre differential that sends
+// the share `front` of its torque forward: the axles' speeds weighted by their torque shares.
+double motor_wheel_speed(const CarState& s, double front);
 
 // State derivative; `forces` (optional) receives the tyre forces.
 CarState car_derivative(const CarConstants& c, const CarState& s, const CarInputs& in, CarForces* forces = nullptr);

@@ -151,10 +151,13 @@ EvidenceResult generate_evidence(const EvidenceOptions& o, const std::string& cs
     chain.issue(t, cmd.first, cmd.second);
     for (int i = 0; i < substeps; ++i) {
       const double ti = t + i * dt;
-      const auto [wheel_angle, torque] = chain.step(ti, dt, s[kWr] * car.wheel_radius_m);
+      const double front_share = std::clamp(car.front_torque_share + o.truth.front_torque_share, 0.0, 1.0);
+      const double motor_rim_mps = motor_wheel_speed(s, front_share) * car.wheel_radius_m;
+      const auto [wheel_angle, torque] = chain.step(ti, dt, motor_rim_mps);
       CarInputs in;
       in.wheel_angle_rad = wheel_angle;
       in.motor_torque_Nm = torque;
+      in.front_torque_share = front_share;
       in.grip_scale = ground.map.grip(s[kX], s[kY]);
       const sim::Vec2 slope = ground.map.slope(s[kX], s[kY]);
       ground_gravity_body(slope.x, slope.y, s[kYaw], car.gravity_mps2, &in.gravity_x_mps2, &in.gravity_y_mps2);

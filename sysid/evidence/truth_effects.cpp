@@ -27,6 +27,7 @@ const std::vector<std::pair<std::string, double TruthEffects::*>>& fields() {
       {"payload_mass_scale", &TruthEffects::payload_mass_scale},
       {"payload_yaw_inertia_scale", &TruthEffects::payload_yaw_inertia_scale},
       {"weight_shift", &TruthEffects::weight_shift},
+      {"front_torque_share", &TruthEffects::front_torque_share},
       {"grade", &TruthEffects::grade},
       {"bump_height_m", &TruthEffects::bump_height_m},
       {"bump_radius_m", &TruthEffects::bump_radius_m},
@@ -73,6 +74,10 @@ const std::vector<TruthEffectInfo>& truth_effect_catalogue() {
       {"weight_shift", {"weight_shift"}, {"weight_distribution"},
        "the CG sits further back along the wheelbase (a battery moved): both axles' loads and lever arms",
        "weight_shift=0.03", "weight_shift=0.08"},
+      {"four_wheel_drive", {"front_torque_share"}, {"drive_split"},
+       "the motor drives both axles through an open centre differential that sends this share of its torque "
+       "forward (its speed the shares' mean of the axles' wheel speeds)",
+       "front_torque_share=0.2", "front_torque_share=0.5"},
       {"hill", {"grade"}, {"road_grade"}, "tilted ground plane dz/dx = grade (gravity g sin theta along it)",
        "grade=0.02", "grade=0.06"},
       {"bump", {"bump_height_m", "bump_radius_m"}, {"ground_bump", "road_grade"},

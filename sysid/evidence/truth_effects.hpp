@@ -25,6 +25,7 @@ struct TruthEffects {
   double front_rolling_coefficient = 0, rear_rolling_coefficient = 0;  // per axle, x its load
   double payload_mass_scale = 1, payload_yaw_inertia_scale = 1;
   double weight_shift = 0;        // the CG sits this share of the wheelbase further back (a battery moved)
+  double front_torque_share = 0;  // four-wheel drive: an open centre differential sends this share forward
   double grade = 0;               // a hill: constant grade dz/dx of the whole ground plane
   // A bump: a raised-cosine hill of this height [m] (negative: a dip) and radius on the track.
   double bump_height_m = 0;

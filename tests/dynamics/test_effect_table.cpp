@@ -273,6 +273,26 @@ TEST_CASE("a weight distribution is the base model with its CG moved along the w
   CHECK_THROWS_WITH(CorrectedSingleTrack(SingleTrack(), beyond), Catch::Contains("cg_to_rear_axle_m"));
 }
 
+TEST_CASE("a drive split is the base model with that share of the motor torque on the front axle", "[effects]") {
+  const float u[2] = {0.2f, 0.8f};
+  EffectParams e;
+  e.front_drive_shift = 0.4;
+  SingleTrackParams four_wheel;
+  four_wheel.front_drive_share = 0.4;
+  CHECK(max_difference_after(SingleTrack(four_wheel), CorrectedSingleTrack(SingleTrack(), e), u, u, 500) < 1e-5f);
+  CHECK(max_difference_after(SingleTrack(), CorrectedSingleTrack(SingleTrack(), e), u, u, 500) > 1e-2f);
+  // The share stays within [0, 1]: a shift past it is the whole torque on one axle.
+  e.front_drive_shift = 1.0;
+  four_wheel.front_drive_share = 0.6;
+  SingleTrackParams front_only;
+  front_only.front_drive_share = 1.0;
+  CHECK(max_difference_after(SingleTrack(front_only), CorrectedSingleTrack(SingleTrack(four_wheel), e), u, u, 500) < 1e-5f);
+  // The double-track model drives its rear axle only: refused with the reason.
+  EffectParams split;
+  split.front_drive_shift = 0.3;
+  CHECK_THROWS_WITH(DoubleTrackWithEffects(DoubleTrack(), split), Catch::Contains("front_drive_share"));
+}
+
 TEST_CASE("a grip patch is the base model with the friction curve scaled on the patch only", "[effects]") {
   SingleTrackParams slippery;  // the friction curve (peak and vertical shift) x 0.5
   slippery.tyre.D *= 0.5;

@@ -67,7 +67,9 @@ State ref_rhs(const SingleTrackParams& p, const State& x, double steer, double t
   const double frz = m * g - ffz;
   const std::complex<double> f_front_wheel = mu_front * ffz, f_rear = mu_rear * frz;
   const std::complex<double> f_front_body = f_front_wheel * to_body;
-  const double torque = p.stall_torque_Nm * (throttle - wr * R / p.no_load_speed_mps);
+  // The motor turns with the axles' wheel speeds weighted by their shares of its torque.
+  const double front_share = p.front_drive_share, rear_share = 1 - front_share;
+  const double torque = p.stall_torque_Nm * (throttle - (front_share * wf + rear_share * wr) * R / p.no_load_speed_mps);
   const double resist = -p.rolling_resistance * m * g * std::tanh(vx / p.rolling_resistance_speed_mps) -
                         p.aero_drag_kgpm * vx * std::abs(vx);
   State dx{};
@@ -78,8 +80,8 @@ State ref_rhs(const SingleTrackParams& p, const State& x, double steer, double t
   dx[4] = (f_front_body.imag() + f_rear.imag()) / m - vx * r;
   dx[5] = (f_front_body.imag() * lf - f_rear.imag() * lr) / p.yaw_inertia_kgm2;
   dx[6] = 0;
-  dx[7] = -f_front_wheel.real() * R / p.front_wheel_inertia_kgm2;
-  dx[8] = (torque - f_rear.real() * R) / p.rear_wheel_inertia_kgm2;
+  dx[7] = (front_share * torque - f_front_wheel.real() * R) / p.front_wheel_inertia_kgm2;
+  dx[8] = (rear_share * torque - f_rear.real() * R) / p.rear_wheel_inertia_kgm2;
   return dx;
 }
 
@@ -161,6 +163,7 @@ TEST_CASE("Single-track derivatives match the reference at random states", "[phy
     p.rear_tyre_C_scale = 0.8;
     p.rear_tyre_D_scale = 1.2;
   }
+  SECTION("four-wheel drive: 40 % of the motor torque on the front axle") { p.front_drive_share = 0.4; }
   const SingleTrack model(p);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> U(-1, 1);
@@ -175,6 +178,40 @@ TEST_CASE("Single-track derivatives match the reference at random states", "[phy
     const State ref = ref_rhs(p, x, u[0], u[1]);
     for (int i = 0; i < 9; ++i) REQUIRE(dx[i] == Approx(ref[i]).epsilon(1e-9).margin(1e-9));
   }
+}
+
+// Closed form: a launch on Coulomb tyres (C = 1, B huge: mu = D at any real slip), no load
+// transfer (h = 0), no resistances, a motor far stronger than the grip. Rear-wheel drive spins the
+// rear wheels only: the rear axle's static load m g l_f / L pushes the car and the rolling front
+// wheels, a = D g (l_f / L) m / (m + I_f / R^2). With any share of the torque on the front axle
+// both axles spin: a = D g.
+TEST_CASE("Single-track drive split: traction-limited launch, rear- against four-wheel drive",
+          "[physics][single_track]") {
+  SingleTrackParams p;
+  p.tyre = {1000.0, 1.0, 0.6, 0.0, 0.0, 0.0};
+  p.cg_height_m = 0;
+  p.rolling_resistance = 0;
+  p.aero_drag_kgpm = 0;
+  p.stall_torque_Nm = 400;
+  p.no_load_speed_mps = 200;
+  const double g = p.gravity_mps2, D = p.tyre.D;
+  auto launch_accel = [&](double share) {
+    p.front_drive_share = share;
+    const SingleTrack m(p);
+    auto x = step1(m, initial(m, 2.0f), 0.f, 1.f, 0.002f, 250);  // 0.5 s: the wheels spin up
+    const float v0 = x[st::kVx];
+    x = step1(m, x, 0.f, 1.f, 0.002f, 250);
+    return (x[st::kVx] - v0) / 0.5;
+  };
+  const double rolling_front_kg = p.front_wheel_inertia_kgm2 / (p.wheel_radius_m * p.wheel_radius_m);
+  CHECK(launch_accel(0.0) == Approx(D * g * p.cg_to_front_axle_m / p.wheelbase_m() * p.mass_kg /
+                                    (p.mass_kg + rolling_front_kg)).epsilon(0.02));
+  CHECK(launch_accel(0.5) == Approx(D * g).epsilon(0.02));
+  CHECK(launch_accel(0.25) == Approx(D * g).epsilon(0.02));
+  p.front_drive_share = 1.2;
+  std::string why;
+  CHECK_FALSE(p.is_valid(&why));
+  CHECK(why.find("front_drive_share") != std::string::npos);
 }
 
 TEST_CASE("Single-track forces: static loads, load transfer, free rolling", "[physics][single_track]") {

@@ -191,6 +191,45 @@ TEST_CASE("evidence: a weight shift moves the static axle loads to m g (l_r - d)
   CHECK(std::abs(car_derivative(c, s, unshifted)[kR] - ds[kR]) > 0.1);
 }
 
+// Closed form: a launch on Coulomb tyres (C = 1, B huge: mu = D at any real slip), no load
+// transfer, a motor far stronger than the grip. Rear-wheel drive spins the rear wheels only: the
+// rear axle's load m g l_f / L pushes the car and the rolling front wheels,
+// a = D g (l_f / L) m / (m + I_f / R^2); with a share of the torque sent forward both axles spin: a = D g.
+TEST_CASE("evidence: four-wheel drive sends its share of the torque forward; a launch reaches D g instead of the rear axle's share", "[evidence]") {
+  CarConstants c = frictionless_straight();
+  c.mf_B = 1000;
+  c.mf_C = 1;
+  c.mf_D = 0.6;
+  c.mf_E = c.mf_Sh = c.mf_Sv = 0;
+  c.cg_height_m = 0;
+  const double g = c.gravity_mps2;
+  CarState s = rolling(2.0, c);
+  s[kWr] += 10;
+  s[kWf] += 5;
+  CarInputs split;
+  split.motor_torque_Nm = 300;
+  split.front_torque_share = 0.3;
+  CarForces f;
+  const CarState ds = car_derivative(c, s, split, &f);
+  CHECK(ds[kWf] * c.front_wheel_inertia_kgm2 + f.front.fx_N * c.wheel_radius_m == Approx(0.3 * 300).epsilon(1e-12));
+  CHECK(ds[kWr] * c.rear_wheel_inertia_kgm2 + f.rear.fx_N * c.wheel_radius_m == Approx(0.7 * 300).epsilon(1e-12));
+  CHECK(motor_wheel_speed(s, 0.3) == Approx(0.3 * s[kWf] + 0.7 * s[kWr]).epsilon(1e-15));
+  auto launch_accel = [&](double share) {
+    CarInputs in;
+    in.motor_torque_Nm = 300;
+    in.front_torque_share = share;
+    CarState x = rolling(2.0, c);
+    for (int i = 0; i < 500; ++i) x = rk4_step(c, x, in, 0.001);  // the driven wheels spin up
+    const double v0 = x[kVx];
+    for (int i = 0; i < 500; ++i) x = rk4_step(c, x, in, 0.001);
+    return (x[kVx] - v0) / 0.5;
+  };
+  const double rolling_front_kg = c.front_wheel_inertia_kgm2 / (c.wheel_radius_m * c.wheel_radius_m);
+  CHECK(launch_accel(0.0) ==
+        Approx(c.mf_D * g * c.lf_m / (c.lf_m + c.lr_m) * c.mass_kg / (c.mass_kg + rolling_front_kg)).epsilon(0.02));
+  CHECK(launch_accel(0.5) == Approx(c.mf_D * g).epsilon(0.02));
+}
+
 TEST_CASE("evidence: a grade adds -g sin(theta) along the slope and nothing across it", "[evidence]") {
   const CarConstants c = frictionless_straight();
   const double grade = 0.08, theta = std::atan(grade);

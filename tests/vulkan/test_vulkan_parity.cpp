@@ -174,6 +174,12 @@ TEST_CASE("Vulkan parity: single-track with per-axle tyres, AutoRally cost", "[v
   check_parity(mppi::SingleTrack{p}, "single-track, per-axle tyres");
 }
 
+TEST_CASE("Vulkan parity: single-track with four-wheel drive, AutoRally cost", "[vulkan][parity]") {
+  mppi::SingleTrackParams p;  // 40 % of the motor torque on the front axle
+  p.front_drive_share = 0.4;
+  check_parity(mppi::SingleTrack{p}, "single-track, four-wheel drive");
+}
+
 TEST_CASE("Vulkan rollout() of given controls equals the CPU backend's", "[vulkan][parity]") {
   const int device = mppi::test::vulkan_test_device();
   if (device < 0) return;
