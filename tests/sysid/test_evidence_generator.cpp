@@ -195,7 +195,7 @@ TEST_CASE("evidence: a weight shift moves the static axle loads to m g (l_r - d)
 // transfer, a motor far stronger than the grip. Rear-wheel drive spins the rear wheels only: the
 // rear axle's load m g l_f / L pushes the car and the rolling front wheels,
 // a = D g (l_f / L) m / (m + I_f / R^2); with a share of the torque sent forward both axles spin: a = D g.
-TEST_CASE("evidence: four-wheel drive sends its share of the torque forward; a launch reaches D g instead of the rear axle's share", "[evidence]") {
+TEST_CASE("evidence: four-wheel drive sends its share of the torque forward, and a launch reaches D g instead of the rear axle's share", "[evidence]") {
   CarConstants c = frictionless_straight();
   c.mf_B = 1000;
   c.mf_C = 1;
