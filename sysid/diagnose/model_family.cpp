@@ -52,6 +52,8 @@ class WrappedFamily final : public ModelFamily {
     return m;
   }
   bool supports(const std::string& effect_id) const override {
+    // Only the single-track can drive its front axle; the four-wheel models refuse a drive split.
+    if (effect_id == "drive_split") return requires { Base::kOmegaFront; };
     return WithEffects<Base>::kChassisEffects || effect_spec(effect_id).hook != EffectHook::kChassis;
   }
   CorrectedModelFile file(const EffectParams& e, const std::vector<std::string>& selected) const override {

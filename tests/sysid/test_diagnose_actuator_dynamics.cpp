@@ -115,3 +115,9 @@ TEST_CASE("a parameter at the end of its range in the joint refit is held at its
     CHECK_THAT(j.not_identified[0].second, Catch::Contains("upper end"));
   }
 }
+
+TEST_CASE("a drive split is a candidate for the single-track nominal only", "[diagnose]") {
+  CHECK(make_model_family("single-track")->supports("drive_split"));
+  CHECK_FALSE(make_model_family("double-track")->supports("drive_split"));
+  CHECK_FALSE(make_model_family("full-vehicle")->supports("drive_split"));
+}
