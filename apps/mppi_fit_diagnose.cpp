@@ -344,7 +344,7 @@ void add_diagnose_options(CLI::App& cmd, DiagnoseArgs& a) {
                  "fit on all of --log, judge on this other recording (replaces --holdout); repeat for a cross-recording table")
       ->type_name("FILE");
   cmd.add_option("--effects", a.effects, "candidate effect ids (default: all)")->type_name("A,B,...");
-  cmd.add_option("--max-effects", a.o.selection.max_effects, "at most N effects named")->type_name("N");
+  cmd.add_option("--max-effects", a.o.selection.max_effects, "at most N selection rounds (a joint candidate such as steer_gain+steer_offset is one)")->type_name("N");
   cmd.add_option("--min-improvement", a.o.selection.min_val_improvement,
                  "validation-cost reduction an effect must give")
       ->type_name("F");

@@ -460,7 +460,7 @@ void register_sysid(py::module_& m) {
 
   // ---- diagnose ----
   m.def("diagnose", &diagnose, py::arg("log"), py::arg("params") = "", py::arg("holdout") = "0.3",
-        py::arg("validate") = "", py::arg("effects") = std::vector<std::string>{}, py::arg("max_effects") = 3,
+        py::arg("validate") = "", py::arg("effects") = std::vector<std::string>{}, py::arg("max_effects") = mppi::diagnose::SelectionOptions{}.max_effects,
         py::arg("min_improvement") = 0.03, py::arg("min_bic_drop") = 2.0, py::arg("out_dir") = "",
         py::arg("plots") = true, py::arg("model") = mppi::models::SingleTrackModel::kName,
         "sim-vs-real diagnosis as mppi-fit diagnose: log (recording or raw real one), model (nominal: "

@@ -70,7 +70,11 @@ struct SelectionOptions {
   double min_val_improvement = 0.03;
   double min_bic_drop = 2.0;        // and BIC decrease (effective sample count; 2 = "positive evidence")
   double samples_per_independent = 5.0;  // residual correlation: samples per independent one
-  int max_effects = 3;
+  // Selection rounds at most; each names one candidate, which may be joint (steer_gain+steer_offset,
+  // motor_freewheel+drag_brake). A real car can miss several things at once (delays, the ESC's
+  // neutral, the weight distribution, the tyre): every round must still pass the gain, BIC and
+  // stability bars, so the cap only bounds the run time.
+  int max_effects = 5;
   std::vector<std::string> candidates;  // empty = the whole library
   // Forward validation: the last part of the training data (in time) judges what the earlier
   // part fitted, so an effect must hold on data that come later.

@@ -68,6 +68,9 @@ struct GreedyResult {
   std::vector<CandidateFit> first_round;  // every candidate of the pool, alone on the nominal
   std::vector<std::pair<int, std::string>> at_limit;  // passed, but a parameter is a bound
   std::vector<int> passed;  // every candidate that passed in some round
+  // The fitted state after each round (its chosen effects refitted together), before backward
+  // elimination: what was chosen by then, and the effects.
+  std::vector<std::pair<std::vector<int>, EffectParams>> rounds;
 };
 
 // Greedy forward selection over `pool` (indices into cands): each round fits every remaining
@@ -244,6 +247,7 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
         base_val = mean_cost(val, base);
       }
     }
+    out.rounds.emplace_back(out.chosen, base);
   }
   // Backward elimination: an effect whose removal (the others refitted together) costs less than
   // the improvement a new effect must bring on the validation data was made redundant by a later one.
@@ -285,6 +289,29 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
   }
   out.effects = base;
   return out;
+}
+
+// Where the final joint refit of the named effects starts. Later rounds refit the earlier effects
+// together with effects that end up not named (unstable, another form of a named one), which can
+// move them to another local optimum. So the refit starts from the last round state that holds
+// named effects only (its values for those; the rest from `fallback`), or from the selection's
+// final state where every effect it kept is named.
+EffectParams joint_refit_start(const GreedyResult& main, const std::vector<const EffectSpec*>& cands,
+                               const std::vector<std::string>& named, const EffectParams& fallback) {
+  auto all_named = [&](const std::vector<int>& chosen) {
+    for (int i : chosen)
+      if (std::find(named.begin(), named.end(), cands[static_cast<std::size_t>(i)]->id) == named.end()) return false;
+    return true;
+  };
+  if (all_named(main.chosen)) return fallback;
+  EffectParams start = fallback;
+  for (auto it = main.rounds.rbegin(); it != main.rounds.rend(); ++it) {
+    if (!all_named(it->first)) continue;
+    for (int i : it->first)
+      for (const EffectParamSpec& p : cands[static_cast<std::size_t>(i)]->params) start.*(p.member) = it->second.*(p.member);
+    break;
+  }
+  return start;
 }
 
 // Block bootstrap of segments: blocks of consecutive segments drawn with replacement.
@@ -544,7 +571,8 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
   // Joint refit of the named effects on all training segments (parameters at a bound held at
   // their nominal value, or the effect dropped: sysid/diagnose/joint_refit.hpp).
   if (!named.empty()) {
-    const JointRefit joint = refit_named_jointly(all, named, only(named, family_effects), opt.range_limit_margin);
+    const JointRefit joint =
+        refit_named_jointly(all, named, only(named, joint_refit_start(main, cands, named, family_effects)), opt.range_limit_margin);
     for (const auto& l : joint.log) log.push_back(l);
     for (const auto& [id, why] : joint.not_identified)
       for (std::size_t i = 0; i < cands.size(); ++i)
