@@ -73,7 +73,7 @@ struct SelectionOptions {
   // Selection rounds at most; each names one candidate, which may be joint (steer_gain+steer_offset,
   // motor_freewheel+drag_brake). A real car can miss several things at once (delays, the ESC's
   // neutral, the weight distribution, the tyre): every round must still pass the gain, BIC and
-  // stability bars, so the cap only bounds the run time.
+  // stability thresholds, so the cap only bounds the run time.
   int max_effects = 5;
   std::vector<std::string> candidates;  // empty = the whole library
   // Forward validation: the last part of the training data (in time) judges what the earlier

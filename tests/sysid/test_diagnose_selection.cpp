@@ -179,7 +179,7 @@ sim::Recording straight_line_drive(std::uint64_t seed, double duration_s) {
 }  // namespace
 
 // A car can miss several things at once; the selection goes on past three rounds while each
-// effect passes its bars (a cap of three would leave one of these out).
+// effect passes the selection thresholds (a cap of three would leave one of these out).
 TEST_CASE("four hidden effects at once are all named, in four selection rounds", "[diagnose][slow]") {
   std::vector<std::string> ids;
   const DiagnoseResult r =
