@@ -42,6 +42,9 @@ const char* kCalibrateUsage = R"(usage: mppi-fit calibrate [options]
   --train-s S          training command sequence length                     (100)
   --heldout-s S        held-out command sequence length                     (100)
   --seed N             training seed; the held-out sequence uses N + 1000   (1)
+  --dither S,T         white noise (std) added to every steering / throttle
+                       command of both sequences, as MPPI's applied commands
+                       carry its exploration noise                          (0,0)
   --horizon S          open-loop prediction horizon of the objective        (1)
   --stride S           a rollout starts every S seconds                     (0.5)
   --iterations N       Levenberg-Marquardt iterations at most               (40)
@@ -145,6 +148,11 @@ int mppi_fit_calibrate(int argc, char** argv) {
         const double s = number(a, value());
         if (!(s >= 0 && s == std::floor(s))) throw Error("--seed expects a non-negative integer");
         train_opt.seed = static_cast<std::uint64_t>(s);
+      } else if (a == "--dither") {
+        const std::vector<std::string> parts = split_list(value());
+        if (parts.size() != 2) throw Error("--dither expects STEER_STD,THROTTLE_STD");
+        train_opt.steer_dither_std = held_opt.steer_dither_std = number(a, parts[0]);
+        train_opt.throttle_dither_std = held_opt.throttle_dither_std = number(a, parts[1]);
       } else if (a == "--horizon") {
         cal.error.horizon_s = number(a, value());
         cal.error.report_horizons_s = {0.1 * cal.error.horizon_s, 0.25 * cal.error.horizon_s,

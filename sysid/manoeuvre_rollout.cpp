@@ -50,6 +50,8 @@ bool ManoeuvreOptions::is_valid(std::string* why) const {
   if (!(min_throttle < max_throttle)) return fail("min_throttle must be < max_throttle");
   if (!(speed_gain_per_mps >= 0)) return fail("speed_gain_per_mps must be >= 0");
   if (!(initial_speed_mps >= 0)) return fail("initial_speed_mps must be >= 0");
+  if (!(steer_dither_std >= 0 && steer_dither_std <= 1 && throttle_dither_std >= 0 && throttle_dither_std <= 1))
+    return fail("steer_dither_std and throttle_dither_std must be in [0, 1]");
   return true;
 }
 
@@ -61,6 +63,10 @@ sim::Recording roll_out_manoeuvres(const RolloutStep& step, std::vector<double> 
   x[state::kVx] = o.initial_speed_mps;
   std::mt19937_64 rng(o.seed);
   std::normal_distribution<double> gauss(0.0, 1.0);
+  // The dither has its own stream, so a recording with dither is the same drive plus the dither.
+  // (A distribution of its own too: std::normal_distribution may cache a draw of its engine.)
+  std::mt19937_64 dither_rng(o.seed ^ 0x9e3779b97f4a7c15ULL);
+  std::normal_distribution<double> dither_gauss(0.0, 1.0);
 
   sim::Recording rec;
   rec.columns.assign(sim::kRecordingRequiredColumns.begin(), sim::kRecordingRequiredColumns.end());
@@ -129,8 +135,10 @@ sim::Recording roll_out_manoeuvres(const RolloutStep& step, std::vector<double> 
     }
     steer_noise = a * steer_noise + b * 0.08 * gauss(rng);
     throttle_noise = a * throttle_noise + b * 0.05 * gauss(rng);
-    const double u[2] = {std::clamp(steer + steer_noise, -0.99, 0.99),
-                         std::clamp(throttle + throttle_noise, o.min_throttle, o.max_throttle)};
+    const double steer_dither = o.steer_dither_std * dither_gauss(dither_rng);
+    const double throttle_dither = o.throttle_dither_std * dither_gauss(dither_rng);
+    const double u[2] = {std::clamp(steer + steer_noise + steer_dither, -0.99, 0.99),
+                         std::clamp(throttle + throttle_noise + throttle_dither, o.min_throttle, o.max_throttle)};
     const double row[11] = {static_cast<double>(i) * o.sample_dt_s, x[state::kX], x[state::kY],
                             x[state::kYaw], x[state::kVx], x[state::kVy], x[state::kYawRate],
                             u[0], u[1], x[state::kRoll], static_cast<double>(piece.manoeuvre)};

@@ -34,6 +34,11 @@ struct ManoeuvreOptions {
   double recover_yaw_rate_radps = 2.5;
   double recover_lateral_mps = 2.0;
   double recover_below_mps = 3.5;
+  // White command noise added to every sample (std, normalised command units), as an MPPI
+  // controller's applied commands carry its exploration noise when few samples dominate the
+  // weights. 0 = none.
+  double steer_dither_std = 0.0;
+  double throttle_dither_std = 0.0;
   // Column names for the model's states after the common 7 (x[7], x[8], ...), recorded too
   // when given (e.g. "omega_front", "omega_rear" for the single-track's wheel speeds).
   std::vector<std::string> extra_state_columns;

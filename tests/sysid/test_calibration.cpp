@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <tuple>
 
 #include <catch2/catch.hpp>
 
@@ -68,6 +69,42 @@ TEST_CASE("the scripted manoeuvres cover the paper's speed range and all five ma
   o.seed = 2;
   const sim::Recording other = roll_out_manoeuvres(network_step(net), std::vector<double>(7, 0.0), o);
   CHECK(other.column("steer")[400] != rec.column("steer")[400]);
+}
+
+TEST_CASE("command dither is white noise of the asked size on top of the same drive", "[sysid][calibration]") {
+  // A car that never changes state: the scripted commands then depend on time only, so the
+  // dithered recording minus the plain one is the dither itself (where no limit clips it).
+  const RolloutStep frozen = [](std::vector<double>&, const double*, double) {};
+  ManoeuvreOptions plain;
+  plain.duration_s = 200;
+  plain.initial_speed_mps = 6.0;  // inside the driver's regime: no recovery
+  ManoeuvreOptions dithered = plain;
+  dithered.steer_dither_std = 0.15;
+  dithered.throttle_dither_std = 0.05;
+  const std::vector<double> x0(7, 0.0);
+  const sim::Recording a = roll_out_manoeuvres(frozen, x0, plain);
+  const sim::Recording b = roll_out_manoeuvres(frozen, x0, dithered);
+  for (const auto& [column, expected_std, lo, hi] :
+       {std::tuple{"steer", 0.15, -0.99, 0.99}, std::tuple{"throttle", 0.05, -0.99, 0.65}}) {
+    const auto& ua = a.column(column);
+    const auto& ub = b.column(column);
+    std::vector<double> d;
+    for (std::size_t i = 0; i < ua.size(); ++i)
+      if (ua[i] > lo + 3 * expected_std && ua[i] < hi - 3 * expected_std && ub[i] > lo && ub[i] < hi)
+        d.push_back(ub[i] - ua[i]);  // (3 std from the limits, so clipping does not bias the sample)
+    REQUIRE(d.size() > ua.size() / 3);
+    double mean = 0, var = 0, lag1 = 0;
+    for (double v : d) mean += v / static_cast<double>(d.size());
+    for (double v : d) var += (v - mean) * (v - mean) / static_cast<double>(d.size());
+    for (std::size_t i = 1; i < d.size(); ++i) lag1 += (d[i] - mean) * (d[i - 1] - mean);
+    lag1 /= var * static_cast<double>(d.size() - 1);
+    INFO(column << ": mean " << mean << ", std " << std::sqrt(var) << ", lag-1 autocorrelation " << lag1);
+    CHECK(std::abs(mean) < 0.01);
+    CHECK(std::sqrt(var) == Approx(expected_std).epsilon(0.05));
+    CHECK(std::abs(lag1) < 0.05);  // white: independent from one sample to the next
+  }
+  dithered.steer_dither_std = 1.5;
+  CHECK_THROWS_WITH(roll_out_manoeuvres(frozen, x0, dithered), Catch::Contains("dither"));
 }
 
 TEST_CASE("calibration recovers known drivetrain, brake, steering and tyre parameters", "[sysid][calibration]") {
