@@ -7,6 +7,23 @@
 
 namespace mppi::diagnose {
 
+EffectParams joint_refit_start(const std::vector<SelectionRound>& rounds, const std::vector<std::string>& final_chosen,
+                               const std::vector<std::string>& named, const EffectParams& fallback) {
+  auto all_named = [&](const std::vector<std::string>& chosen) {
+    return std::all_of(chosen.begin(), chosen.end(),
+                       [&](const std::string& id) { return std::find(named.begin(), named.end(), id) != named.end(); });
+  };
+  if (all_named(final_chosen)) return fallback;
+  EffectParams start = fallback;
+  for (auto it = rounds.rbegin(); it != rounds.rend(); ++it) {
+    if (!all_named(it->chosen)) continue;
+    for (const std::string& id : it->chosen)
+      for (const EffectParamSpec& p : effect_spec(id).params) start.*(p.member) = it->effects.*(p.member);
+    break;
+  }
+  return start;
+}
+
 JointRefit refit_named_jointly(const FitProblem& all, const std::vector<std::string>& named_in, EffectParams start,
                                double range_limit_margin) {
   JointRefit out;

@@ -24,6 +24,21 @@ struct JointRefit {
 // An effect with nothing else left to fit is not identified and is dropped. Each pass finalises,
 // drops an effect or holds a parameter, so the loop ends. A change time (DataGrid::kTime) was
 // searched over the data and stays where `start` has it.
+// One round of a greedy selection: the effect ids chosen by then and their fitted values.
+struct SelectionRound {
+  std::vector<std::string> chosen;
+  EffectParams effects;
+};
+
+// Where the joint refit of `named` starts. Later rounds of a selection refit the earlier effects
+// together with effects that end up not named (unstable, another form of a named one), which can
+// move them to another local optimum. So the refit starts from the last round whose chosen
+// effects are all named (its values for those effects; every other parameter from `fallback`),
+// or from `fallback` itself when every effect of the selection's final state (`final_chosen`) is
+// named or no round qualifies.
+EffectParams joint_refit_start(const std::vector<SelectionRound>& rounds, const std::vector<std::string>& final_chosen,
+                               const std::vector<std::string>& named, const EffectParams& fallback);
+
 JointRefit refit_named_jointly(const FitProblem& all, const std::vector<std::string>& named, EffectParams start,
                                double range_limit_margin);
 

@@ -291,27 +291,10 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
   return out;
 }
 
-// Where the final joint refit of the named effects starts. Later rounds refit the earlier effects
-// together with effects that end up not named (unstable, another form of a named one), which can
-// move them to another local optimum. So the refit starts from the last round state that holds
-// named effects only (its values for those; the rest from `fallback`), or from the selection's
-// final state where every effect it kept is named.
-EffectParams joint_refit_start(const GreedyResult& main, const std::vector<const EffectSpec*>& cands,
-                               const std::vector<std::string>& named, const EffectParams& fallback) {
-  auto all_named = [&](const std::vector<int>& chosen) {
-    for (int i : chosen)
-      if (std::find(named.begin(), named.end(), cands[static_cast<std::size_t>(i)]->id) == named.end()) return false;
-    return true;
-  };
-  if (all_named(main.chosen)) return fallback;
-  EffectParams start = fallback;
-  for (auto it = main.rounds.rbegin(); it != main.rounds.rend(); ++it) {
-    if (!all_named(it->first)) continue;
-    for (int i : it->first)
-      for (const EffectParamSpec& p : cands[static_cast<std::size_t>(i)]->params) start.*(p.member) = it->second.*(p.member);
-    break;
-  }
-  return start;
+std::vector<SelectionRound> rounds_of(const GreedyResult& main, const std::vector<const EffectSpec*>& cands) {
+  std::vector<SelectionRound> rounds;
+  for (const auto& [chosen, effects] : main.rounds) rounds.push_back({ids_of(cands, chosen), effects});
+  return rounds;
 }
 
 // Block bootstrap of segments: blocks of consecutive segments drawn with replacement.
@@ -572,7 +555,7 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
   // their nominal value, or the effect dropped: sysid/diagnose/joint_refit.hpp).
   if (!named.empty()) {
     const JointRefit joint =
-        refit_named_jointly(all, named, only(named, joint_refit_start(main, cands, named, family_effects)), opt.range_limit_margin);
+        refit_named_jointly(all, named, only(named, joint_refit_start(rounds_of(main, cands), ids_of(cands, main.chosen), named, family_effects)), opt.range_limit_margin);
     for (const auto& l : joint.log) log.push_back(l);
     for (const auto& [id, why] : joint.not_identified)
       for (std::size_t i = 0; i < cands.size(); ++i)

@@ -15,6 +15,7 @@
 #include "dynamics/with_effects.hpp"
 #include "sysid/diagnose/diagnose.hpp"
 #include "sysid/diagnose/identifiability.hpp"
+#include "sysid/diagnose/joint_refit.hpp"
 #include "sysid/diagnose/synth.hpp"
 #include "dynamics/single_track.hpp"
 #include <random>
@@ -405,4 +406,49 @@ TEST_CASE("the parallel selection gives the one-thread result", "[diagnose][slow
   for (std::size_t i = 0; i < serial.selection.final_params.size(); ++i)
     CHECK(parallel.selection.final_params[i].value == serial.selection.final_params[i].value);
   CHECK(parallel.heldout_rmse_reduction == serial.heldout_rmse_reduction);
+}
+
+TEST_CASE("the joint refit starts from the last selection round that holds named effects only",
+          "[sysid][diagnose][selection]") {
+  // A hand-built selection: round 1 took a steering delay, round 2 added a tyre saturation (not
+  // named in the end), round 3 a steering trim; later rounds moved the delay.
+  auto set = [](EffectParams e, const std::string& id, double v) {
+    e.*(effect_spec(id).params[0].member) = v;
+    return e;
+  };
+  auto get = [](const EffectParams& e, const std::string& id) { return e.*(effect_spec(id).params[0].member); };
+  EffectParams r1 = set({}, "steer_delay", 0.08);
+  EffectParams r2 = set(set(r1, "steer_delay", 0.15), "tire_saturation", 0.7);
+  EffectParams r3 = set(set(set(r2, "steer_delay", 0.20), "tire_saturation", 0.6), "steer_offset", 0.05);
+  const std::vector<SelectionRound> rounds = {{{"steer_delay"}, r1},
+                                              {{"steer_delay", "tire_saturation"}, r2},
+                                              {{"steer_delay", "tire_saturation", "steer_offset"}, r3}};
+  const std::vector<std::string> final_chosen = rounds.back().chosen;
+  const EffectParams fallback = set(set(set(set({}, "steer_delay", 0.3), "tire_saturation", 0.9), "steer_offset", 0.04),
+                                    "throttle_delay", 0.11);
+
+  SECTION("named: delay and trim -> round 1's delay, the trim and the rest from the fallback") {
+    const EffectParams s = joint_refit_start(rounds, final_chosen, {"steer_delay", "steer_offset"}, fallback);
+    CHECK(get(s, "steer_delay") == 0.08);
+    CHECK(get(s, "steer_offset") == 0.04);
+    CHECK(get(s, "tire_saturation") == 0.9);
+    CHECK(get(s, "throttle_delay") == 0.11);
+  }
+  SECTION("named: delay and tyre -> round 2, the last round with nothing else") {
+    const EffectParams s = joint_refit_start(rounds, final_chosen, {"tire_saturation", "steer_delay"}, fallback);
+    CHECK(get(s, "steer_delay") == 0.15);
+    CHECK(get(s, "tire_saturation") == 0.7);
+    CHECK(get(s, "steer_offset") == 0.04);
+  }
+  SECTION("everything the selection kept is named -> the fallback (the final state)") {
+    const EffectParams s =
+        joint_refit_start(rounds, final_chosen, {"steer_offset", "steer_delay", "tire_saturation"}, fallback);
+    for (const std::string id : {"steer_delay", "tire_saturation", "steer_offset", "throttle_delay"})
+      CHECK(get(s, id) == get(fallback, id));
+  }
+  SECTION("no round holds named effects only -> the fallback") {
+    const EffectParams s = joint_refit_start(rounds, final_chosen, {"steer_offset"}, fallback);
+    CHECK(get(s, "steer_delay") == 0.3);
+    CHECK(get(s, "steer_offset") == 0.04);
+  }
 }
