@@ -349,6 +349,15 @@ void add_diagnose_options(CLI::App& cmd, DiagnoseArgs& a) {
                  "validation-cost reduction an effect must give")
       ->type_name("F");
   cmd.add_option("--min-bic-drop", a.o.selection.min_bic_drop, "and BIC decrease")->type_name("B");
+  cmd.add_option("--stability-resamples", a.o.selection.stability_resamples,
+                 "block-bootstrap resamples of the fit data for stability selection (more: finer inclusion frequencies, "
+                 "longer run; 0: off)")
+      ->type_name("N")
+      ->check(CLI::Range(0, 200));
+  cmd.add_option("--min-inclusion", a.o.selection.min_inclusion_frequency,
+                 "share of the resamples that must choose an effect before it is named")
+      ->type_name("F")
+      ->check(CLI::Range(0.0, 1.0));
   cmd.add_option("--max-body-slip", a.o.control_loss.max_body_slip_deg,
                  "rows whose body slip exceeds this (a spin), and 0.5 s around, are left out of the fits (0: none)")
       ->type_name("DEG")
