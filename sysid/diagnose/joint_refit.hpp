@@ -18,12 +18,6 @@ struct JointRefit {
   std::vector<std::string> log;              // one line per decision
 };
 
-// Fits the parameters of `named` together on `all`, from `start`. A parameter that ends at the end
-// of its search range (range_limit_param) is held at its nominal value and the effect's other
-// parameters refitted: the nested, simpler form (a rolling resistance without its viscous part).
-// An effect with nothing else left to fit is not identified and is dropped. Each pass finalises,
-// drops an effect or holds a parameter, so the loop ends. A change time (DataGrid::kTime) was
-// searched over the data and stays where `start` has it.
 // One round of a greedy selection: the effect ids chosen by then and their fitted values.
 struct SelectionRound {
   std::vector<std::string> chosen;
@@ -39,6 +33,12 @@ struct SelectionRound {
 EffectParams joint_refit_start(const std::vector<SelectionRound>& rounds, const std::vector<std::string>& final_chosen,
                                const std::vector<std::string>& named, const EffectParams& fallback);
 
+// Fits the parameters of `named` together on `all`, from `start`. A parameter that ends at the end
+// of its search range (range_limit_param) is held at its nominal value and the effect's other
+// parameters refitted: the nested, simpler form (a rolling resistance without its viscous part).
+// An effect with nothing else left to fit is not identified and is dropped. Each pass finalises,
+// drops an effect or holds a parameter, so the loop ends. A change time (DataGrid::kTime) was
+// searched over the data and stays where `start` has it.
 JointRefit refit_named_jointly(const FitProblem& all, const std::vector<std::string>& named, EffectParams start,
                                double range_limit_margin);
 

@@ -69,8 +69,8 @@ struct GreedyResult {
   std::vector<std::pair<int, std::string>> at_limit;  // passed, but a parameter is a bound
   std::vector<int> passed;  // every candidate that passed in some round
   // The fitted state after each round (its chosen effects refitted together), before backward
-  // elimination: what was chosen by then, and the effects.
-  std::vector<std::pair<std::vector<int>, EffectParams>> rounds;
+  // elimination: the ids chosen by then, and the effects.
+  std::vector<SelectionRound> rounds;
 };
 
 // Greedy forward selection over `pool` (indices into cands): each round fits every remaining
@@ -247,7 +247,7 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
         base_val = mean_cost(val, base);
       }
     }
-    out.rounds.emplace_back(out.chosen, base);
+    out.rounds.push_back({ids_of(cands, out.chosen), base});
   }
   // Backward elimination: an effect whose removal (the others refitted together) costs less than
   // the improvement a new effect must bring on the validation data was made redundant by a later one.
@@ -289,12 +289,6 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
   }
   out.effects = base;
   return out;
-}
-
-std::vector<SelectionRound> rounds_of(const GreedyResult& main, const std::vector<const EffectSpec*>& cands) {
-  std::vector<SelectionRound> rounds;
-  for (const auto& [chosen, effects] : main.rounds) rounds.push_back({ids_of(cands, chosen), effects});
-  return rounds;
 }
 
 // Block bootstrap of segments: blocks of consecutive segments drawn with replacement.
@@ -554,8 +548,8 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
   // Joint refit of the named effects on all training segments (parameters at a bound held at
   // their nominal value, or the effect dropped: sysid/diagnose/joint_refit.hpp).
   if (!named.empty()) {
-    const JointRefit joint =
-        refit_named_jointly(all, named, only(named, joint_refit_start(rounds_of(main, cands), ids_of(cands, main.chosen), named, family_effects)), opt.range_limit_margin);
+    const EffectParams start = joint_refit_start(main.rounds, ids_of(cands, main.chosen), named, family_effects);
+    const JointRefit joint = refit_named_jointly(all, named, only(named, start), opt.range_limit_margin);
     for (const auto& l : joint.log) log.push_back(l);
     for (const auto& [id, why] : joint.not_identified)
       for (std::size_t i = 0; i < cands.size(); ++i)
