@@ -328,6 +328,19 @@ std::function<int()> guarded(std::shared_ptr<Args> args, int (*run)(Args&)) {
   };
 }
 
+// The stability selection's settings, shared by diagnose and its sweep.
+void add_stability_options(CLI::App& cmd, SelectionOptions& selection) {
+  cmd.add_option("--stability-resamples", selection.stability_resamples,
+                 "block-bootstrap resamples of the fit data for stability selection (more: finer inclusion frequencies, "
+                 "longer run; 0: off)")
+      ->type_name("N")
+      ->check(CLI::Range(0, 200));
+  cmd.add_option("--min-inclusion", selection.min_inclusion_frequency,
+                 "share of the resamples that must choose an effect before it is named")
+      ->type_name("F")
+      ->check(CLI::Range(0.0, 1.0));
+}
+
 void add_diagnose_options(CLI::App& cmd, DiagnoseArgs& a) {
   cmd.add_option("--log", a.logs,
                  "recording (docs/RECORDING_FORMAT.md), or a real recording (DART / ETH CSV, or "
@@ -349,15 +362,7 @@ void add_diagnose_options(CLI::App& cmd, DiagnoseArgs& a) {
                  "validation-cost reduction an effect must give")
       ->type_name("F");
   cmd.add_option("--min-bic-drop", a.o.selection.min_bic_drop, "and BIC decrease")->type_name("B");
-  cmd.add_option("--stability-resamples", a.o.selection.stability_resamples,
-                 "block-bootstrap resamples of the fit data for stability selection (more: finer inclusion frequencies, "
-                 "longer run; 0: off)")
-      ->type_name("N")
-      ->check(CLI::Range(0, 200));
-  cmd.add_option("--min-inclusion", a.o.selection.min_inclusion_frequency,
-                 "share of the resamples that must choose an effect before it is named")
-      ->type_name("F")
-      ->check(CLI::Range(0.0, 1.0));
+  add_stability_options(cmd, a.o.selection);
   cmd.add_option("--max-body-slip", a.o.control_loss.max_body_slip_deg,
                  "rows whose body slip exceeds this (a spin), and 0.5 s around, are left out of the fits (0: none)")
       ->type_name("DEG")
@@ -398,6 +403,7 @@ void add_sweep_options(CLI::App& cmd, SweepArgs& a) {
   cmd.add_option("--duration", a.duration, "recording length [s]")->type_name("S");
   add_driver_speed_options(cmd, a.driver);
   cmd.add_option("--min-bic-drop", a.sel.min_bic_drop, "BIC decrease an effect must give")->type_name("B");
+  add_stability_options(cmd, a.sel);
   mppi::cli::add_model_option(cmd, "--nominal", a.driver.nominal_model, "truth base and diagnosed nominal",
                               nominal_models());
   mppi::cli::add_out_option(cmd, a.out, "recordings, runs.jsonl, sweep.md (recordings already there are reused)");

@@ -31,6 +31,7 @@ const char* kEvidenceUsage = R"(usage:
   mppi-fit diagnose sweep --generator independent [--reduced] [--seeds N] [--sizes small,large]
         [--effects A,B] [--pairs N] [--clean N] [--duration S] [--jobs N] [--out DIR] [--md FILE]
         [--vehicle FILE.yaml]  (the car's constants, also the diagnosis' nominal) [--rate HZ]
+        [--stability-resamples N] [--min-inclusion F]  (the diagnosis' stability selection, as in diagnose)
         [--summarize DIR]  (only the table, from DIR/runs.jsonl of a sweep, finished or not)
         [--resume]  (keep the runs DIR/runs.jsonl already has, run the rest; same options as before)
         (full grid: 5 seeds, every effect at both sizes, 8 pairs, 20 effect-free; --reduced: 1 seed,
@@ -116,6 +117,7 @@ int evidence_sweep(int argc, char** argv) {
   int seeds = -1, pairs = -1, clean = -1, jobs = 1;
   std::vector<std::string> sizes, effects;
   double duration = 60;
+  diagnose::SelectionOptions selection;  // the diagnosis' defaults unless asked otherwise
   std::string out = "out/evidence_sweep", md_copy, summarize, vehicle;
   for (int i = 2; i < argc; ++i) {
     const std::string f = argv[i];
@@ -135,7 +137,15 @@ int evidence_sweep(int argc, char** argv) {
     else if (f == "--jobs") jobs = std::max(1, static_cast<int>(number(f, value())));
     else if (f == "--out") out = value();
     else if (f == "--vehicle") vehicle = value();
-    else if (f == "--rate") {
+    else if (f == "--stability-resamples") {
+      const double n = number(f, value());
+      if (n < 0 || n > 200 || n != static_cast<int>(n)) throw UsageError(f + " expects a whole number in [0, 200]");
+      selection.stability_resamples = static_cast<int>(n);
+    } else if (f == "--min-inclusion") {
+      selection.min_inclusion_frequency = number(f, value());
+      if (!(selection.min_inclusion_frequency >= 0 && selection.min_inclusion_frequency <= 1))
+        throw UsageError(f + " expects a share in [0, 1]");
+    } else if (f == "--rate") {
       grid.rate_hz = number(f, value());
       evidence::log_interval_s(grid.rate_hz);  // checked before the first run
     } else if (f == "--md") md_copy = value();
@@ -188,12 +198,14 @@ int evidence_sweep(int argc, char** argv) {
   if (!jsonl) throw Error(jsonl_path + ": cannot write");
   std::atomic<std::size_t> next{0};
   std::mutex io;
-  std::printf("%zu runs, %d job(s) -> %s\n", cases.size(), jobs, out.c_str());
+  std::printf("%zu runs, %d job(s), stability selection: %d resamples, named at inclusion >= %.2f -> %s\n",
+              cases.size(), jobs, selection.stability_resamples, selection.min_inclusion_frequency, out.c_str());
   auto worker = [&] {
     for (std::size_t k = next++; k < cases.size(); k = next++) {
       if (done[k]) continue;
       diagnose::DiagnoseOptions o;
       o.plots = false;
+      o.selection = selection;
       runs[k] = diagnose::run_evidence_case(cases[k], out, grid.duration_s, o, grid.vehicle_yaml, grid.rate_hz);
       const auto& r = runs[k];
       std::lock_guard<std::mutex> lock(io);

@@ -123,6 +123,12 @@ EvidenceRun run_evidence_case(const EvidenceCase& c, const std::string& dir, dou
     const auto family = make_model_family("single-track", g.vehicle_yaml);
     const DiagnoseResult r = run_diagnosis(d, *family, o);
     run.named = r.selection.selected;
+    for (const auto& id : run.named) {
+      double inclusion = -1;
+      for (const auto& cand : r.selection.candidates)
+        if (cand.id == id) inclusion = cand.inclusion_frequency;
+      run.named_inclusion.push_back(inclusion);
+    }
     for (const auto& s : r.selection.suspected) run.suspected.push_back(s.id);
 
     bool all_out = true, all_named = true;
@@ -165,6 +171,7 @@ std::string evidence_run_json(const EvidenceRun& r) {
   j["driver"] = r.driver;
   j["crashes"] = r.crashes;
   j["named"] = r.named;
+  j["named_inclusion"] = r.named_inclusion;
   j["suspected"] = r.suspected;
   j["acceptable_ids"] = r.acceptable;
   j["out_of_library"] = r.out_of_library;
@@ -199,6 +206,7 @@ std::vector<EvidenceRun> read_evidence_runs(const std::string& jsonl_path) {
       r.driver = j.at("driver");
       r.crashes = j.at("crashes");
       r.named = j.at("named").get<std::vector<std::string>>();
+      if (j.contains("named_inclusion")) r.named_inclusion = j.at("named_inclusion").get<std::vector<double>>();
       r.suspected = j.at("suspected").get<std::vector<std::string>>();
       r.acceptable = j.at("acceptable_ids").get<std::vector<std::string>>();
       r.out_of_library = j.at("out_of_library");

@@ -24,6 +24,7 @@ struct EvidenceRun {
   std::string track, direction, driver;
   int crashes = 0;
   std::vector<std::string> named, suspected, acceptable;  // acceptable: ids of the truth effects
+  std::vector<double> named_inclusion;  // per named effect: share of the stability resamples that chose it (-1: none)
   bool out_of_library = false;   // every hidden effect is outside the library
   bool right = false;            // every in-library effect named by an acceptable id (out of library: nothing named)
   bool wrong = false;            // an id named that no hidden effect accounts for

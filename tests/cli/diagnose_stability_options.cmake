@@ -1,7 +1,9 @@
 # mppi-fit diagnose --stability-resamples reaches the stability selection: on a recording of the
 # independent generator with a large throttle delay, 3 resamples are drawn (the log counts
 # "of 3 resamples") and the delay is named; with 0 there is no stability selection (no resample
-# lines) and the delay chosen on all the data is named. Needs BIN_DIR, WORK_DIR and SOURCE_DIR.
+# lines) and the delay chosen on all the data is named. The independent generator's sweep passes
+# both settings to its diagnoses: its runs.jsonl gives the named delay's inclusion frequency (a
+# share of 3 resamples) and -1 with 0 resamples. Needs BIN_DIR, WORK_DIR and SOURCE_DIR.
 set(out "${WORK_DIR}/diagnose_stability_options")
 file(REMOVE_RECURSE "${out}")
 file(MAKE_DIRECTORY "${out}")
@@ -27,6 +29,25 @@ foreach(n 3 0)
   endif()
   if(n EQUAL 0 AND err MATCHES "resamples")
     message(FATAL_ERROR "--stability-resamples 0 still resampled:\n${err}")
+  endif()
+endforeach()
+foreach(n 3 0)
+  execute_process(COMMAND "${BIN_DIR}/mppi-fit" diagnose sweep --generator independent --effects throttle_delay
+                          --sizes large --seeds 1 --pairs 0 --clean 0 --duration 20 --stability-resamples ${n}
+                          --min-inclusion 0.6 --out "${out}/sweep${n}"
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE log ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "sweep --stability-resamples ${n} failed (${rc}): ${err}")
+  endif()
+  if(NOT log MATCHES "stability selection: ${n} resamples, named at inclusion >= 0.60")
+    message(FATAL_ERROR "the sweep did not take --stability-resamples ${n} --min-inclusion 0.6:\n${log}")
+  endif()
+  file(READ "${out}/sweep${n}/runs.jsonl" runs)
+  if(n EQUAL 3 AND NOT runs MATCHES "\"named\":\\[\"throttle_delay\"\\],\"named_inclusion\":\\[(1\\.0|0\\.6666)")
+    message(FATAL_ERROR "sweep with 3 resamples: no delay named at a share of 3 resamples >= 0.6:\n${runs}")
+  endif()
+  if(n EQUAL 0 AND NOT runs MATCHES "\"named_inclusion\":\\[-1\\.0\\]")
+    message(FATAL_ERROR "sweep with 0 resamples still reports an inclusion frequency:\n${runs}")
   endif()
 endforeach()
 message(STATUS "PASS: the number of stability resamples reaches the selection")
