@@ -20,7 +20,7 @@ struct SimCommandLine {
   std::string data_dir;      // --data-dir
   RunFile run_file;          // --config, --dump-config
 
-  // mppi-sim's defaults: the library's, writing to out/sim, backend auto.
+  // mppi-sim's defaults: the library's, writing to out/sim, backend auto, upstream's plan smoothing.
   static sim::ClosedLoopConfig defaults();
 };
 

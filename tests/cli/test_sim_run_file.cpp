@@ -171,6 +171,7 @@ TEST_CASE("cli: no flags give mppi-sim's defaults", "[cli]") {
   expected.config = mppi::sim::ClosedLoopConfig{};
   expected.config.out_dir = "out/sim";
   expected.config.backend = mppi::BackendChoice::kAuto;
+  expected.config.controller.smoothing_window = 5;  // upstream's plan smoothing
   require_same(cl, expected);
 }
 
