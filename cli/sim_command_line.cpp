@@ -1,5 +1,7 @@
 #include "cli/sim_command_line.hpp"
 
+#include <string>
+
 #include "cli/app.hpp"
 #include "cli/options.hpp"
 
@@ -80,6 +82,11 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
 
 void finish_sim_options(CLI::App& app, SimCommandLine& cl) {
   cl.run_file.apply(app);
+  const ControllerOptions& mppi = cl.config.controller;
+  if (mppi.smoothing_window > mppi.horizon)
+    throw usage_error("--smoothing", "a window of " + std::to_string(mppi.smoothing_window) +
+                                         " steps (mppi-sim's default: 5) needs --horizon >= " +
+                                         std::to_string(mppi.smoothing_window) + "; --smoothing 0 turns it off");
   cl.config.progress = !cl.quiet;
 }
 

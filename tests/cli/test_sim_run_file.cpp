@@ -250,6 +250,12 @@ TEST_CASE("cli: bad flags and values on the command line are refused by name", "
   CHECK(parse_error({"--horizon", "1.5"}).find("--horizon") != std::string::npos);
   CHECK(parse_error({"--threads", "-2"}).find("--threads") != std::string::npos);
   CHECK(parse_error({"--speed", "7"}).empty());
+  // The default plan smoothing (5 steps) does not fit a 3-step horizon: the message says how out.
+  const std::string short_horizon = parse_error({"--horizon", "3"});
+  CHECK(short_horizon.find("--smoothing") != std::string::npos);
+  CHECK(short_horizon.find("--smoothing 0") != std::string::npos);
+  CHECK(parse_error({"--horizon", "3", "--smoothing", "0"}).empty());
+  CHECK(parse_error({"--horizon", "3", "--smoothing", "3"}).empty());
 }
 
 TEST_CASE("cli: --dump-config round-trips", "[cli]") {
