@@ -62,7 +62,8 @@
 //                                         a recording shows, not the car: the diagnosis' replay
 //                                         applies them, WithEffects' physics ignores them.
 //   force:    aero_drag                   extra force -c vx |vx|
-//             rolling_resistance          extra force -(F0 tanh(vx / 0.5) + b vx)
+//             rolling_resistance          extra force -(F0 tanh(v / 0.5) + b v) at each axle along its
+//                                         wheel (v: its rolling speed), shared as the static load
 //             road_grade                  a tilted plane z = gx x + gy y: -m g grad z
 //             ground_bump                 a hill (h > 0) or dip (h < 0) at a place: z = h (1 + cos(pi d /
 //                                         R)) / 2 within R of its centre, 0 beyond: -m g grad z
@@ -196,7 +197,7 @@ inline const std::vector<EffectSpec>& effect_table() {
   static const std::vector<EffectSpec> table = {
       {"aero_drag", "extra air drag F = -c vx|vx|", H::kForce,
        {{"aero_drag_kgpm", &E::aero_drag_kgpm, "N s^2/m^2", kAny, -0.05, 3.0, 0.1}}, {}, DataGrid::kNone, X::kSpeedRange},
-      {"rolling_resistance", "extra rolling resistance F = -(F0 tanh(vx/0.5) + b vx)", H::kForce,
+      {"rolling_resistance", "extra rolling resistance F = -(F0 tanh(v/0.5) + b v) along each wheel, shared by the axles as the static load", H::kForce,
        {{"rolling_force_N", &E::rolling_force_N, "N", kAny, -10.0, 60.0, 2.0},
         {"rolling_viscous_Nspm", &E::rolling_viscous_Nspm, "N s/m", kAny, -5.0, 30.0, 1.0}}, {}, DataGrid::kNone, X::kSpeedRange},
       {"steer_delay", "pure delay of the steering command", H::kActuator,

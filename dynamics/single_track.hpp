@@ -136,21 +136,22 @@ class SingleTrack {
   // x <- x + dt f(x, u) (explicit Euler), every lane. Float, fast branch-free math.
   template <int W>
   void step(Batch<kNx, W> x, ConstBatch<kNu, W> u, float dt_s, float* /*scratch*/) const noexcept {
-    step_impl<W, false>(x, u, dt_s, nullptr, nullptr);
+    step_impl<W, false>(x, u, dt_s, nullptr, nullptr, nullptr);
   }
 
-  // step() with extra accelerations along the body axes [m/s^2] per lane, added inside the
-  // force balance (the force hook of WithEffects<SingleTrack>).
+  // step() with extra accelerations along the body axes [m/s^2] and about the vertical axis
+  // [rad/s^2] per lane, added inside the force balance (the force hook of WithEffects<SingleTrack>).
   template <int W>
   void step_with_body_accel(Batch<kNx, W> x, ConstBatch<kNu, W> u, float dt_s, float* /*scratch*/,
-                            const float* ax_mps2, const float* ay_mps2) const noexcept {
-    step_impl<W, true>(x, u, dt_s, ax_mps2, ay_mps2);
+                            const float* ax_mps2, const float* ay_mps2,
+                            const float* yaw_accel_radps2) const noexcept {
+    step_impl<W, true>(x, u, dt_s, ax_mps2, ay_mps2, yaw_accel_radps2);
   }
 
  private:
   template <int W, bool kExtraAccel>
   void step_impl(Batch<kNx, W> x, ConstBatch<kNu, W> u, float dt_s, const float* ax_mps2,
-                 const float* ay_mps2) const noexcept {
+                 const float* ay_mps2, const float* yaw_accel_radps2) const noexcept {
     const SingleTrackCoeffs<float> k = kf_;  // local copy: no aliasing with the state
     float* px = x[state::kX];
     float* py = x[state::kY];
@@ -175,11 +176,12 @@ class SingleTrack {
       if constexpr (kExtraAccel) {
         pvx[j] = vx + (e.dvx_mps2 + ax_mps2[j]) * dt_s;
         pvy[j] = vy + (e.dvy_mps2 + ay_mps2[j]) * dt_s;
+        pr[j] = r + (e.dyaw_rate_radps2 + yaw_accel_radps2[j]) * dt_s;
       } else {
         pvx[j] = vx + e.dvx_mps2 * dt_s;
         pvy[j] = vy + e.dvy_mps2 * dt_s;
+        pr[j] = r + e.dyaw_rate_radps2 * dt_s;
       }
-      pr[j] = r + e.dyaw_rate_radps2 * dt_s;
       pwf[j] += e.domega_front_radps2 * dt_s;
       pwr[j] += e.domega_rear_radps2 * dt_s;
     }

@@ -15,11 +15,13 @@
 //     single-track and four-wheel models); the kinematic bicycle and the network have none, so
 //     these are refused;
 //   - force: aero_drag, rolling_resistance, road_grade and ground_bump add an acceleration along
-//     the body axes. A base that offers step_with_body_accel (the single-track model) takes it inside
-//     its force balance; for the others it is added to v_x (and v_y where the base has a
-//     lateral velocity) after the base step (operator splitting over one plant step). Mass: the
-//     base's own, or for bases without one the AutoRally car's (SingleTrackParams defaults; the
-//     network models that car).
+//     the body axes, and the rolling resistance of the steered front wheels a yaw acceleration
+//     (it acts along each wheel, so a turned front wheel pulls the nose back). A base that offers
+//     step_with_body_accel (the single-track model) takes them inside its force balance; for the
+//     others they are added to v_x (and v_y and the yaw rate where the base has a lateral velocity)
+//     after the base step (operator splitting over one plant step). Mass, yaw inertia, axle
+//     positions and steering range: the base's own, or for bases without them the AutoRally car's
+//     (SingleTrackParams defaults; the network models that car).
 // State: the base's kNx, then time [s], then the steer and throttle actuator chains
 // (kActuatorDelayStages delay stages, one lag stage with the rate limit, one play stage for the
 // backlash, whose output is applied).
@@ -59,7 +61,7 @@ concept HasSingleTrackCore = requires(const Base& b) {
 // A base that takes extra body-axis accelerations inside its force balance.
 template <class Base>
 concept HasBodyAccelHook = requires(const Base& b, Batch<Base::kNx, 1> x, ConstBatch<Base::kNu, 1> u, float* a) {
-  b.template step_with_body_accel<1>(x, u, 0.f, a, a, a);
+  b.template step_with_body_accel<1>(x, u, 0.f, a, a, a, a);
 };
 
 template <VehicleDynamics Base>
@@ -90,6 +92,12 @@ class WithEffects {
     drag_per_kg_ = static_cast<float>(effects_.aero_drag_kgpm / m);
     roll_per_kg_ = static_cast<float>(effects_.rolling_force_N / m);
     visc_per_kg_ = static_cast<float>(effects_.rolling_viscous_Nspm / m);
+    rolling_ = effects_.rolling_force_N != 0.0 || effects_.rolling_viscous_Nspm != 0.0;
+    // The resistance is shared by the axles as the static load is (front: l_r / L).
+    front_roll_share_ = static_cast<float>(car.cg_to_rear_axle_m / (car.cg_to_front_axle_m + car.cg_to_rear_axle_m));
+    front_arm_m_ = static_cast<float>(car.cg_to_front_axle_m);
+    mass_per_yaw_inertia_ = static_cast<float>(m / car.yaw_inertia_kgm2);
+    max_steer_rad_ = static_cast<float>(car.max_steer_rad);
     if constexpr (kChassisEffects) {  // motor_freewheel, drag_brake: in units of the normalised command
       esc_ = effects_.motor_freewheel_share > 0.0 || effects_.drag_brake_mps2 > 0.0;
       freewheel_per_mps_ = static_cast<float>(effects_.motor_freewheel_share / car.no_load_speed_mps);
@@ -200,6 +208,7 @@ class WithEffects {
     const ActuatorCoeffs k = actuator_coeffs(effects_, dt_s);
     float applied[kNu * W];  // the command the base model sees, per lane
     float ax[W], ay[W];      // force hook: body-axis accelerations from the start-of-step state
+    float yaw_accel[W];      // and the yaw acceleration [rad/s^2]
     float other_w[W];        // weight of the other grip (after a change, on the patch) per lane
     int before_lanes = 0, blended_lanes = 0;
     for (int j = 0; j < W; ++j) {
@@ -222,9 +231,10 @@ class WithEffects {
       if (esc_) applied[control::kThrottle * W + j] = esc_throttle(applied[control::kThrottle * W + j], motor_rim_speed<W>(x, j));
       float gx = grade_x_, gy = grade_y_;  // g x the ground's slope here (plane + bump)
       if (bump_) add_bump_slope(x[state::kX][j], x[state::kY][j], &gx, &gy);
-      ax[j] = -drag_per_kg_ * vx * std::abs(vx) - roll_per_kg_ * phys::tanh(vx * 2.f) - visc_per_kg_ * vx -
-              (gx * cy + gy * sy);
+      ax[j] = -drag_per_kg_ * vx * std::abs(vx) - (gx * cy + gy * sy);
       ay[j] = -(-gx * sy + gy * cy);
+      yaw_accel[j] = 0.f;
+      if (rolling_) add_rolling_resistance(x, j, applied[control::kSteer * W + j], &ax[j], &ay[j], &yaw_accel[j]);
       other_w[j] = other_grip_weight(x[kTime][j], x[state::kX][j], x[state::kY][j]);
       before_lanes += other_w[j] == 0.f;
       blended_lanes += other_w[j] > 0.f && other_w[j] < 1.f;
@@ -232,14 +242,14 @@ class WithEffects {
     const Batch<Base::kNx, W> xb{x.data};
     const ConstBatch<Base::kNu, W> ub{applied};
     if (before_lanes == 0 && blended_lanes == 0) {
-      base_step<W>(after_, xb, ub, dt_s, scratch, ax, ay);
+      base_step<W>(after_, xb, ub, dt_s, scratch, ax, ay, yaw_accel);
     } else if (before_lanes == W) {
-      base_step<W>(before_, xb, ub, dt_s, scratch, ax, ay);
+      base_step<W>(before_, xb, ub, dt_s, scratch, ax, ay, yaw_accel);
     } else {  // lanes on both sides of a grip change or patch edge: step both, blend per lane
       float copy[Base::kNx * W];
       std::copy(x.data, x.data + Base::kNx * W, copy);
-      base_step<W>(before_, Batch<Base::kNx, W>{copy}, ub, dt_s, scratch, ax, ay);
-      base_step<W>(after_, xb, ub, dt_s, scratch, ax, ay);
+      base_step<W>(before_, Batch<Base::kNx, W>{copy}, ub, dt_s, scratch, ax, ay, yaw_accel);
+      base_step<W>(after_, xb, ub, dt_s, scratch, ax, ay, yaw_accel);
       for (int j = 0; j < W; ++j) {
         const float w = other_w[j];
         if (w == 1.f) continue;
@@ -280,6 +290,23 @@ class WithEffects {
     if (z < -6.9f) return 1.f;
     return 1.f / (1.f + std::exp(z));
   }
+  // Rolling resistance F0 tanh(v / 0.5) + b v against each axle's rolling speed v, along its
+  // wheel: the rear along the body's x axis, the front turned by the wheel angle delta, so that
+  // steered front wheels also push the car sideways and turn its nose back (-l_f F_front sin delta).
+  template <int W>
+  void add_rolling_resistance(Batch<kNx, W> x, int j, float applied_steer, float* ax, float* ay,
+                              float* yaw_accel) const noexcept {
+    const float vx = x[state::kVx][j], vy = x[state::kVy][j], r = x[state::kYawRate][j];
+    const float delta = std::clamp(applied_steer, -1.f, 1.f) * max_steer_rad_;
+    float sd, cd;
+    fast_sincos(delta, &sd, &cd);
+    const float front_v = vx * cd + (vy + front_arm_m_ * r) * sd;  // the front wheel's rolling speed
+    auto per_kg = [this](float v) { return roll_per_kg_ * phys::tanh(v * 2.f) + visc_per_kg_ * v; };
+    const float front = front_roll_share_ * per_kg(front_v), rear = (1.f - front_roll_share_) * per_kg(vx);
+    *ax -= front * cd + rear;
+    *ay -= front * sd;
+    *yaw_accel -= mass_per_yaw_inertia_ * front_arm_m_ * front * sd;
+  }
   // Adds g x the bump's slope (dz/dx, dz/dy) at (x, y) to (gx, gy).
   void add_bump_slope(float x_m, float y_m, float* gx, float* gy) const noexcept {
     const float dx = x_m - bump_x_, dy = y_m - bump_y_;
@@ -299,14 +326,17 @@ class WithEffects {
   // else added after its step.
   template <int W>
   static void base_step(const Base& base, Batch<Base::kNx, W> x, ConstBatch<Base::kNu, W> u, float dt_s,
-                        float* scratch, const float* ax, const float* ay) noexcept {
+                        float* scratch, const float* ax, const float* ay, const float* yaw_accel) noexcept {
     if constexpr (HasBodyAccelHook<Base>) {
-      base.template step_with_body_accel<W>(x, u, dt_s, scratch, ax, ay);
+      base.template step_with_body_accel<W>(x, u, dt_s, scratch, ax, ay, yaw_accel);
     } else {
       base.template step<W>(x, u, dt_s, scratch);
       for (int j = 0; j < W; ++j) {
         x[state::kVx][j] += ax[j] * dt_s;
-        if constexpr (kLateralVelocity) x[state::kVy][j] += ay[j] * dt_s;
+        if constexpr (kLateralVelocity) {
+          x[state::kVy][j] += ay[j] * dt_s;
+          x[state::kYawRate][j] += yaw_accel[j] * dt_s;
+        }
       }
     }
   }
@@ -339,6 +369,8 @@ class WithEffects {
   EffectParams effects_;
   Base before_, after_;
   float drag_per_kg_ = 0, roll_per_kg_ = 0, visc_per_kg_ = 0, grade_x_ = 0, grade_y_ = 0, change_time_ = 0;
+  bool rolling_ = false;
+  float front_roll_share_ = 0.5f, front_arm_m_ = 0, mass_per_yaw_inertia_ = 0, max_steer_rad_ = 0;
   bool grip_changes_ = false, patch_ = false, bump_ = false;
   float bump_x_ = 0, bump_y_ = 0, bump_r_ = 0, bump_slope_ = 0;
   struct Disc {

@@ -35,9 +35,9 @@ class SingleTrackOnSurface {
       for (int i = 0; i < kNu; ++i) us[i] = u[i][j];
       const double px = xs[state::kX], py = xs[state::kY];
       const Vec2 g = surface_->gravity_body_mps2(px, py, xs[state::kYaw], params_.gravity_mps2);
-      const float ax = static_cast<float>(g.x), ay = static_cast<float>(g.y);
+      const float ax = static_cast<float>(g.x), ay = static_cast<float>(g.y), no_yaw_accel = 0.f;
       model_for(surface_->grip(px, py))
-          .template step_with_body_accel<1>(Batch<kNx, 1>{xs}, ConstBatch<kNu, 1>{us}, dt_s, scratch, &ax, &ay);
+          .template step_with_body_accel<1>(Batch<kNx, 1>{xs}, ConstBatch<kNu, 1>{us}, dt_s, scratch, &ax, &ay, &no_yaw_accel);
       for (int i = 0; i < kNx; ++i) x[i][j] = xs[i];
     }
   }

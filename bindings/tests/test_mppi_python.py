@@ -31,6 +31,7 @@ def sim_config(out_dir=""):
     c.laps = RUN["laps"]
     c.controller.num_samples = RUN["samples"]
     c.controller.seed = RUN["seed"]
+    c.controller.smoothing_window = 5  # mppi-sim's default (upstream's plan smoothing); the library's is off
     c.progress = False
     c.out_dir = out_dir
     return c

@@ -134,6 +134,46 @@ TEMPLATE_LIST_TEST_CASE("force effects add their closed-form acceleration in one
   if constexpr (M::kLateralVelocity) CHECK(xw[state::kVy] - xb[state::kVy] == Approx(ay * dt_s).epsilon(2e-3));
 }
 
+TEMPLATE_LIST_TEST_CASE("rolling resistance acts along each wheel: steered, it also pushes sideways and turns the nose back",
+                        "[effects]", CorrectedNominalModels) {
+  using D = TestType;
+  using Base = typename D::Model;
+  using M = WithEffects<Base>;
+  EffectParams e;
+  e.rolling_force_N = 15.0;
+  e.rolling_viscous_Nspm = 2.0;
+  const Base base = default_base<D>();
+  const M wrapped(base, e);
+  SingleTrackParams car;  // the geometry: the base's own where it has a single-track core
+  if constexpr (M::kChassisEffects) car = single_track_core(base.params());
+  const double m = car.mass_kg, lf = car.cg_to_front_axle_m, lr = car.cg_to_rear_axle_m;
+  float xb[Base::kNx], xw[M::kNx];
+  std::vector<float> scratch(std::max<std::size_t>(1, base.scratch_floats(1)));
+  for (const float steer : {0.f, 0.5f, -0.8f}) {
+    start(base, xb, 8.f);  // v_x 8 m/s, v_y 0, yaw rate 0.2 rad/s
+    start(wrapped, xw, 8.f);
+    const float u[2] = {steer, 0.f};
+    const float dt_s = 0.002f;
+    base.template step<1>(Batch<Base::kNx, 1>{xb}, ConstBatch<2, 1>{u}, dt_s, scratch.data());
+    wrapped.template step<1>(Batch<M::kNx, 1>{xw}, ConstBatch<2, 1>{u}, dt_s, scratch.data());
+    // Each axle's share of the static load takes F(v) = F0 tanh(2 v) + b v against its own rolling
+    // speed, along its wheel; the front wheel is turned by delta = steer x max steer.
+    const double delta = steer * car.max_steer_rad, vx = 8.0, r = 0.2;
+    const double front_speed = vx * std::cos(delta) + lf * r * std::sin(delta);
+    auto force = [](double v) { return 15.0 * std::tanh(2.0 * v) + 2.0 * v; };
+    const double front_N = lr / (lf + lr) * force(front_speed), rear_N = lf / (lf + lr) * force(vx);
+    const double ax = -(front_N * std::cos(delta) + rear_N) / m;
+    const double ay = -front_N * std::sin(delta) / m;
+    const double yaw_accel = -lf * front_N * std::sin(delta) / car.yaw_inertia_kgm2;
+    INFO("steer " << steer);
+    CHECK(xw[state::kVx] - xb[state::kVx] == Approx(ax * dt_s).epsilon(3e-3));
+    if constexpr (M::kLateralVelocity) {
+      CHECK(xw[state::kVy] - xb[state::kVy] == Approx(ay * dt_s).epsilon(3e-3).margin(1e-7));
+      CHECK(xw[state::kYawRate] - xb[state::kYawRate] == Approx(yaw_accel * dt_s).epsilon(3e-3).margin(1e-7));
+    }
+  }
+}
+
 TEST_CASE("tyre effects are refused where the model has no tyres, with the effect named", "[effects]") {
   EffectParams e;
   e.tyre_peak_scale = 0.8;
