@@ -211,10 +211,13 @@ int evidence_sweep(int argc, char** argv) {
       std::lock_guard<std::mutex> lock(io);
       std::string named;
       for (const auto& s : r.named) named += (named.empty() ? "" : "+") + s;
-      std::printf("[%zu/%zu] %-45s %-8s %-3s %-7s named %-30s right %d wrong %d  1-s RMSE %.3f -> %.3f (%.1f %%)%s%s\n",
+      std::string once;
+      for (const auto& s : r.crossed_once) once += (once.empty() ? "  crossed once: " : "+") + s;
+      std::printf("[%zu/%zu] %-45s %-8s %-3s %-7s named %-30s right %d wrong %d  1-s RMSE %.3f -> %.3f (%.1f %%)%s%s%s\n",
                   k + 1, cases.size(), cases[k].label().c_str(), r.track.c_str(), r.direction.c_str(),
                   r.driver.c_str(), named.empty() ? "-" : named.c_str(), r.right, r.wrong, r.before_clean,
-                  r.after_clean, 100 * r.reduction(), r.error.empty() ? "" : "  ERROR: ", r.error.c_str());
+                  r.after_clean, 100 * r.reduction(), once.c_str(), r.error.empty() ? "" : "  ERROR: ",
+                  r.error.c_str());
       std::fflush(stdout);
       jsonl << diagnose::evidence_run_json(r) << "\n" << std::flush;
     }

@@ -26,7 +26,13 @@ struct EvidenceRun {
   std::vector<std::string> named, suspected, acceptable;  // acceptable: ids of the truth effects
   std::vector<double> named_inclusion;  // per named effect: share of the stability resamples that chose it (-1: none)
   bool out_of_library = false;   // every hidden effect is outside the library
-  bool right = false;            // every in-library effect named by an acceptable id (out of library: nothing named)
+  // Place-dependent effects none of whose discs the car passed twice: no later pass can confirm
+  // them (the recording alone cannot tell a patch from a change in time), so naming them is not
+  // required; naming them is still right.
+  std::vector<std::string> crossed_once;
+  bool right = false;            // every in-library effect named by an acceptable id, those crossed once
+                                 // excepted (out of library, or only effects crossed once: nothing wrong named)
+  bool right_strict = false;     // every in-library effect named, those crossed once included
   bool wrong = false;            // an id named that no hidden effect accounts for
   double before_clean = 0, after_clean = 0;  // held-out normalised 1-s RMSE against the noise-free states
   double reduction() const { return before_clean > 0 ? 1 - after_clean / before_clean : 0; }
@@ -47,6 +53,10 @@ struct EvidenceGrid {
 // The reduced grid: 1 seed, both sizes, 3 pairs, 4 effect-free recordings.
 EvidenceGrid reduced_evidence_grid();
 std::vector<EvidenceCase> evidence_cases(const EvidenceGrid& g);
+
+// Scores r->named against r->c's hidden effects: acceptable ids, right, right_strict, wrong and
+// crossed_once (a place effect none of whose discs the car passed twice, `place_passes`).
+void score_evidence_run(const std::vector<evidence::PlacePasses>& place_passes, EvidenceRun* r);
 
 // Generates (unless the recording exists) and diagnoses one case against the vehicle file the
 // car was built from; never throws (error set).

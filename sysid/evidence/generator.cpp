@@ -80,6 +80,21 @@ struct Sample {
   int segment;  // increments at each respawn
 };
 
+// The passes of the car over a disc: runs of log rows inside it, runs less than kPassGap_s apart
+// merged into one pass.
+std::vector<std::pair<double, double>> passes_over(const std::vector<Sample>& history, int substeps, int rows,
+                                                   double log_dt_s, sim::Vec2 centre, double radius_m) {
+  std::vector<std::pair<double, double>> passes;
+  for (int k = 0; k < rows; ++k) {
+    const CarState& s = history[static_cast<std::size_t>(k) * substeps].s;
+    if (!(std::hypot(s[kX] - centre.x, s[kY] - centre.y) < radius_m)) continue;
+    const double t = k * log_dt_s;
+    if (!passes.empty() && t - passes.back().second <= kPassGap_s) passes.back().second = t;
+    else passes.push_back({t, t});
+  }
+  return passes;
+}
+
 }  // namespace
 
 std::string clean_path_of(const std::string& csv_path) { return stem_of(csv_path) + ".clean.csv"; }
@@ -181,6 +196,17 @@ EvidenceResult generate_evidence(const EvidenceOptions& o, const std::string& cs
       history.push_back({s, segment});
     }
   }
+
+  // Where the grip differs (each patch with its blended edge) and where the ground is not level.
+  if (!ground.patches.empty()) {
+    PlacePasses pp{"grip_patches", {}};
+    for (const auto& p : ground.patches)
+      pp.disc_passes_s.push_back(passes_over(history, substeps, rows, o.log_dt_s, p.centre_m, p.radius_m + p.edge_m));
+    res.place_passes.push_back(pp);
+  }
+  if (ground.bump.radius_m > 0)
+    res.place_passes.push_back(
+        {"bump", {passes_over(history, substeps, rows, o.log_dt_s, ground.bump.centre_m, ground.bump.radius_m)}});
 
   // Rows: the command sent at t_k and the sensors' reading of the state at t_k - offset.
   std::mt19937_64 rng(o.seed * 9176 + 5);
@@ -285,6 +311,19 @@ EvidenceResult generate_evidence(const EvidenceOptions& o, const std::string& cs
         discs.push_back({{"centre_m", {p.centre_m.x, p.centre_m.y}}, {"radius_m", p.radius_m}, {"edge_m", p.edge_m}});
       sizes["patches"] = discs;
     }
+    for (const auto& pp : res.place_passes)  // when the car was on it: [enter, leave] of each pass [s]
+      if (pp.effect == info.name) {
+        auto passes_json = [](const std::vector<std::pair<double, double>>& passes) {
+          json out = json::array();
+          for (const auto& [enter, leave] : passes) out.push_back({enter, leave});
+          return out;
+        };
+        if (info.name == "bump") sizes["passes_s"] = passes_json(pp.disc_passes_s[0]);
+        else
+          for (std::size_t i = 0; i < pp.disc_passes_s.size(); ++i)
+            sizes["patches"][i]["passes_s"] = passes_json(pp.disc_passes_s[i]);
+        e["crossed_once"] = pp.crossed_once();
+      }
     e["sizes"] = sizes;
     e["table_ids"] = info.table_ids;
     e["in_library"] = !info.table_ids.empty();

@@ -9,7 +9,8 @@
 //                   what the sensors show, not noise)
 //   FILE.truth.json the effects, their sizes and forms, and the effect-table ids a diagnosis may
 //                   name for each ("out of library" where none exists); the vehicle file whose
-//                   constants the car has (`vehicle_params`: the nominal to diagnose against)
+//                   constants the car has (`vehicle_params`: the nominal to diagnose against);
+//                   for a place-dependent effect, the times the car was on each disc (`passes_s`)
 // It shares no code with the diagnosis' candidate terms or their effect table (docs/EVIDENCE.md;
 // a test checks its includes).
 #include <cstdint>
@@ -45,10 +46,25 @@ struct EvidenceOptions {
 // 500 Hz; throws mppi::Error otherwise.
 double log_interval_s(double rate_hz, double physics_dt_s = 0.001);
 
+// The times the car spent on a place-dependent effect (grip patches, a bump), per disc of it: one
+// entry per pass, passes less than kPassGap_s apart merged. A place the car crossed once cannot be
+// told from a change in time by the recording alone: no later pass over it confirms it.
+struct PlacePasses {
+  std::string effect;                                                  // catalogue name: grip_patches | bump
+  std::vector<std::vector<std::pair<double, double>>> disc_passes_s;   // per disc: [enter, leave] of each pass [s]
+  bool crossed_once() const {  // no disc passed twice (or never on it at all)
+    for (const auto& d : disc_passes_s)
+      if (d.size() >= 2) return false;
+    return true;
+  }
+};
+inline constexpr double kPassGap_s = 1.0;
+
 struct EvidenceResult {
   std::string csv, clean_csv, truth_json, track, direction, driver;
   std::string vehicle_yaml;  // the vehicle constants read: the nominal a diagnosis should be given
   int crashes = 0, rows = 0;
+  std::vector<PlacePasses> place_passes;  // one per place-dependent effect of the truth
 };
 
 // Throws mppi::Error for bad options or an unwritable path. Deterministic in the options.
