@@ -40,6 +40,19 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
                  "back on the track (0: off)")
       ->type_name("S")
       ->check(CLI::NonNegativeNumber);
+  // Read as doubles and rounded once to float, as the plant's limits hold them.
+  app.add_option_function<double>(
+         "--steer-rate-limit", [&c](double v) { c.actuators.steer_rate_per_s = static_cast<float>(v); },
+         "the simulated car's steering servo: max |d steer / dt| in commands per second (2 / R s lock to lock)")
+      ->type_name("R")
+      ->default_str(CLI::detail::to_string(c.actuators.steer_rate_per_s))
+      ->check(CLI::PositiveNumber);
+  app.add_option_function<double>(
+         "--throttle-rate-limit", [&c](double v) { c.actuators.throttle_rate_per_s = static_cast<float>(v); },
+         "the simulated car's throttle channel: max |d throttle / dt| [1/s]")
+      ->type_name("R")
+      ->default_str(CLI::detail::to_string(c.actuators.throttle_rate_per_s))
+      ->check(CLI::PositiveNumber);
   app.add_option("--samples", mppi.num_samples, "MPPI samples per step")->type_name("K");
   app.add_option("--horizon", mppi.horizon, "MPPI time steps")->type_name("T");
   app.add_option("--iterations", mppi.iterations, "MPPI iterations per step")->type_name("N");

@@ -105,6 +105,7 @@ const std::vector<std::string> kFlags = {
     "--track", "marietta", "--clockwise", "--model", "single-track", "--plant", "double-track",
     "--speed", "7.25", "--laps", "2", "--max-time", "30.5", "--samples", "256", "--horizon", "60",
     "--iterations", "2", "--lambda", "4.5", "--smoothing", "9", "--seed", "12345678901", "--threads", "3",
+    "--steer-rate-limit", "12.5", "--throttle-rate-limit", "7.5",
     "--backend", "cpu", "--cost-config", "my cost.yaml", "--plant-params", "plant.yaml", "--model-params",
     "model.yaml", "--network", "net.npz", "--out", "out/x: y", "--json", "--quiet", "--data-dir", kDataDir};
 const std::string kRunFile = R"(track: marietta
@@ -120,6 +121,8 @@ iterations: 2
 lambda: 4.5
 smoothing: 9
 seed: 12345678901
+steer-rate-limit: 12.5
+throttle-rate-limit: 7.5
 threads: 3
 backend: cpu
 cost-config: my cost.yaml
@@ -152,6 +155,8 @@ TEST_CASE("cli: the flags set the configuration they name", "[cli]") {
   c.controller.smoothing_window = 9;
   c.controller.seed = 12345678901ull;
   c.controller.num_threads = 3;
+  c.actuators.steer_rate_per_s = 12.5f;
+  c.actuators.throttle_rate_per_s = 7.5f;
   c.backend = mppi::BackendChoice::kCpu;
   c.cost_params_yaml = "my cost.yaml";
   c.plant_params_yaml = "plant.yaml";
@@ -250,6 +255,8 @@ TEST_CASE("cli: bad flags and values on the command line are refused by name", "
   CHECK(parse_error({"--horizon", "1.5"}).find("--horizon") != std::string::npos);
   CHECK(parse_error({"--threads", "-2"}).find("--threads") != std::string::npos);
   CHECK(parse_error({"--speed", "7"}).empty());
+  CHECK(parse_error({"--steer-rate-limit", "0"}).find("--steer-rate-limit") != std::string::npos);
+  CHECK(parse_error({"--throttle-rate-limit", "-1"}).find("--throttle-rate-limit") != std::string::npos);
   // The default plan smoothing (5 steps) does not fit a 3-step horizon: the message says how out.
   const std::string short_horizon = parse_error({"--horizon", "3"});
   CHECK(short_horizon.find("--smoothing") != std::string::npos);
