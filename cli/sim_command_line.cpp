@@ -6,6 +6,16 @@
 #include "cli/options.hpp"
 
 namespace mppi::cli {
+namespace {
+
+// A float setting read as a double and rounded once to float (as the options hold it), so that
+// the value given and a run file's round trip agree to the last bit.
+CLI::Option* add_float_option(CLI::App& app, const std::string& name, float& target, const std::string& description) {
+  return app.add_option_function<double>(name, [&target](double v) { target = static_cast<float>(v); }, description)
+      ->default_str(CLI::detail::to_string(target));
+}
+
+}  // namespace
 
 sim::ClosedLoopConfig SimCommandLine::defaults() {
   sim::ClosedLoopConfig c;
@@ -40,27 +50,18 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
                  "back on the track (0: off)")
       ->type_name("S")
       ->check(CLI::NonNegativeNumber);
-  // Read as doubles and rounded once to float, as the plant's limits hold them.
-  app.add_option_function<double>(
-         "--steer-rate-limit", [&c](double v) { c.actuators.steer_rate_per_s = static_cast<float>(v); },
-         "the simulated car's steering servo: max |d steer / dt| in commands per second (2 / R s lock to lock)")
+  add_float_option(app, "--steer-rate-limit", c.actuators.steer_rate_per_s,
+                   "the simulated car's steering servo: max |d steer / dt| in commands per second (2 / R s lock to lock)")
       ->type_name("R")
-      ->default_str(CLI::detail::to_string(c.actuators.steer_rate_per_s))
       ->check(CLI::PositiveNumber);
-  app.add_option_function<double>(
-         "--throttle-rate-limit", [&c](double v) { c.actuators.throttle_rate_per_s = static_cast<float>(v); },
-         "the simulated car's throttle channel: max |d throttle / dt| [1/s]")
+  add_float_option(app, "--throttle-rate-limit", c.actuators.throttle_rate_per_s,
+                   "the simulated car's throttle channel: max |d throttle / dt| [1/s]")
       ->type_name("R")
-      ->default_str(CLI::detail::to_string(c.actuators.throttle_rate_per_s))
       ->check(CLI::PositiveNumber);
   app.add_option("--samples", mppi.num_samples, "MPPI samples per step")->type_name("K");
   app.add_option("--horizon", mppi.horizon, "MPPI time steps")->type_name("T");
   app.add_option("--iterations", mppi.iterations, "MPPI iterations per step")->type_name("N");
-  // Read as a double and rounded once to float, as the controller options hold it.
-  app.add_option_function<double>(
-         "--lambda", [&mppi](double v) { mppi.lambda = static_cast<float>(v); }, "MPPI temperature")
-      ->type_name("L")
-      ->default_str(CLI::detail::to_string(mppi.lambda));
+  add_float_option(app, "--lambda", mppi.lambda, "MPPI temperature")->type_name("L");
   app.add_option("--smoothing", mppi.smoothing_window, "Savitzky-Golay window over the plan (odd, <= the horizon; upstream AutoRally: 5), 0 = off")
       ->type_name("W");
   add_seed_option(app, mppi.seed);

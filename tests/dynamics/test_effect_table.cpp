@@ -32,6 +32,18 @@ void start(const M& m, float* x, float vx_mps) {
   m.init_state(s, x);
 }
 
+// The base model and its corrected twin from the same start at vx_mps, one step of dt_s with
+// command u each: xb and xw hold the states after it.
+template <class B, class W>
+void start_and_step_both(const B& base, const W& wrapped, float* xb, float* xw, float vx_mps, const float (&u)[2],
+                         float dt_s) {
+  std::vector<float> scratch(std::max<std::size_t>({1, base.scratch_floats(1), wrapped.scratch_floats(1)}));
+  start(base, xb, vx_mps);
+  start(wrapped, xw, vx_mps);
+  base.template step<1>(Batch<B::kNx, 1>{xb}, ConstBatch<2, 1>{u}, dt_s, scratch.data());
+  wrapped.template step<1>(Batch<W::kNx, 1>{xw}, ConstBatch<2, 1>{u}, dt_s, scratch.data());
+}
+
 }  // namespace
 
 TEST_CASE("the effect table holds every effect parameter exactly once", "[effects]") {
@@ -119,13 +131,9 @@ TEMPLATE_LIST_TEST_CASE("force effects add their closed-form acceleration in one
     g = single_track_core(base.params()).gravity_mps2;
   }
   float xb[Base::kNx], xw[M::kNx];
-  std::vector<float> scratch(std::max<std::size_t>(1, base.scratch_floats(1)));
-  start(base, xb, 8.f);
-  start(wrapped, xw, 8.f);
   const float u[2] = {0.f, 0.f};
   const float dt_s = 0.002f;
-  base.template step<1>(Batch<Base::kNx, 1>{xb}, ConstBatch<2, 1>{u}, dt_s, scratch.data());
-  wrapped.template step<1>(Batch<M::kNx, 1>{xw}, ConstBatch<2, 1>{u}, dt_s, scratch.data());
+  start_and_step_both(base, wrapped, xb, xw, 8.f, u, dt_s);
   // Drag along body x, and the grade's downhill force split on the body axes (yaw 0.7 rad).
   const double yaw = 0.7;
   const double ax = -0.8 * 8.0 * 8.0 / mass_kg - g * 0.05 * std::cos(yaw);
@@ -148,14 +156,10 @@ TEMPLATE_LIST_TEST_CASE("rolling resistance acts along each wheel: steered, it a
   if constexpr (M::kChassisEffects) car = single_track_core(base.params());
   const double m = car.mass_kg, lf = car.cg_to_front_axle_m, lr = car.cg_to_rear_axle_m;
   float xb[Base::kNx], xw[M::kNx];
-  std::vector<float> scratch(std::max<std::size_t>(1, base.scratch_floats(1)));
   for (const float steer : {0.f, 0.5f, -0.8f}) {
-    start(base, xb, 8.f);  // v_x 8 m/s, v_y 0, yaw rate 0.2 rad/s
-    start(wrapped, xw, 8.f);
     const float u[2] = {steer, 0.f};
     const float dt_s = 0.002f;
-    base.template step<1>(Batch<Base::kNx, 1>{xb}, ConstBatch<2, 1>{u}, dt_s, scratch.data());
-    wrapped.template step<1>(Batch<M::kNx, 1>{xw}, ConstBatch<2, 1>{u}, dt_s, scratch.data());
+    start_and_step_both(base, wrapped, xb, xw, 8.f, u, dt_s);  // v_x 8 m/s, v_y 0, yaw rate 0.2 rad/s
     // Each axle's share of the static load takes F(v) = F0 tanh(2 v) + b v against its own rolling
     // speed, along its wheel; the front wheel is turned by delta = steer x max steer.
     const double delta = steer * car.max_steer_rad, vx = 8.0, r = 0.2;
