@@ -106,6 +106,54 @@ class SelectionLog {
 // The library effects a candidate stands for: itself, or for a joint candidate its two partners.
 using Members = std::vector<std::vector<int>>;
 
+// After the forward rounds: an actuator's dynamics were chosen in the form that fitted best with
+// only what came before it in the model (a lag chosen before the drag that slows the car, whose
+// missing force also shows in the yaw rate). Each other form of the same actuator is fitted in its
+// place with everything else that was chosen, all refitted together; it takes the place where
+// it fits the fit part better (BIC, as many parameters or fewer) and does no worse on the later
+// block, with its parameters inside their range.
+void swap_dynamics_forms(const Folds& folds, const std::vector<const EffectSpec*>& cands, const std::vector<int>& pool,
+                         const SelectionOptions& opt, double n_eff, GreedyResult& out, EffectParams& base,
+                         SelectionLog* log) {
+  for (std::size_t k = 0; k < out.chosen.size(); ++k) {
+    const EffectSpec& current = *cands[static_cast<std::size_t>(out.chosen[k])];
+    if (current.dynamics_of.empty()) continue;
+    double fit_cost = mean_cost(folds.fit, base), val_cost = mean_cost(folds.val, base);
+    std::vector<int> rest = out.chosen;
+    rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(k));
+    const EffectParams rest_effects = only(ids_of(cands, rest), base);
+    for (int j : pool) {
+      const EffectSpec& other = *cands[static_cast<std::size_t>(j)];
+      if (other.dynamics_of != current.dynamics_of || &other == cands[static_cast<std::size_t>(out.chosen[k])] ||
+          std::find(out.chosen.begin(), out.chosen.end(), j) != out.chosen.end())
+        continue;
+      std::vector<int> swapped = out.chosen;
+      swapped[k] = j;
+      FitResult trial = fit_effect(folds.fit, rest_effects, other);
+      const FitResult joint = fit_params(folds.fit, trial.effects, joint_free_params(cands, swapped, trial.effects));
+      if (joint.cost < trial.cost) trial = joint;
+      const double extra_params = static_cast<double>(other.params.size()) -
+                                  static_cast<double>(cands[static_cast<std::size_t>(out.chosen[k])]->params.size());
+      const double bic = n_eff * std::log(trial.cost / fit_cost) + extra_params * std::log(n_eff);
+      const double trial_val = mean_cost(folds.val, trial.effects);
+      if (!(bic < 0.0 && extra_params <= 0.0 && trial_val <= val_cost) ||
+          !range_limit_shortfall(other, trial.effects, opt.range_limit_margin).empty())
+        continue;
+      if (log) {
+        char line[256];
+        std::snprintf(line, sizeof line, "swap: %s in place of %s (with the rest refitted: dBIC %+.1f, validation cost %+.1f %%)",
+                      other.id.c_str(), cands[static_cast<std::size_t>(out.chosen[k])]->id.c_str(), bic,
+                      100 * (trial_val / val_cost - 1.0));
+        log->push_back(line);
+      }
+      out.chosen[k] = j;
+      base = trial.effects;
+      fit_cost = trial.cost;
+      val_cost = trial_val;
+    }
+  }
+}
+
 GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& cands, const Members& members,
                     const std::vector<int>& pool, const SelectionOptions& opt, double n_eff,
                     SelectionLog* log) {
@@ -287,6 +335,7 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
     base = weakest_rest;
     base_val = mean_cost(val, base);
   }
+  swap_dynamics_forms(folds, cands, pool, opt, n_eff, out, base, log);
   out.effects = base;
   return out;
 }

@@ -65,6 +65,37 @@ TEST_CASE("a steering play that the resamples split with a lag is named as the s
   std::filesystem::remove_all(dir);
 }
 
+// The independent generator's exact FIFO steering delay (0.1 s) beside drag along the velocity
+// vector, human-like driver on CCRF. Alone on the nominal, a first-order lag fits the steering a
+// little better than the delay (the missing drag also shows in the yaw rate, which scales with the
+// speed) and is chosen first; once the drag is in the model the delay fits better, and the form is
+// swapped. Without the swap the lag is named.
+TEST_CASE("a steering delay chosen as a lag before the drag was in the model is swapped back to the delay", "[diagnose][slow]") {
+  const auto dir = std::filesystem::temp_directory_path() / "mppi_actuator_swap_test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const evidence::EvidenceResult rec = mppi::test::independent_recording(
+      dir / "delay_drag.csv", "steer_delay_s=0.1,extra_drag_kgpm=0.5", 2, "ccrf", "ccw", "human");
+
+  const DiagData d = load_recording(rec.csv);
+  DiagnoseOptions opt;
+  opt.plots = false;
+  opt.selection.candidates = {"aero_drag", "rolling_resistance", "steer_delay", "steer_lag", "steer_rate_limit", "steer_backlash"};
+  opt.selection.stability_resamples = 0;
+  const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track", rec.vehicle_yaml), opt);
+  std::string named, log;
+  for (const auto& s : r.selection.selected) named += s + " ";
+  for (const auto& l : r.selection.log) log += l + "\n";
+  INFO("named: " << named << "\n" << log);
+  CHECK_THAT(log, Catch::Contains("round 1: selected steer_lag"));  // the situation the swap is for
+  CHECK_THAT(log, Catch::Contains("swap: steer_delay in place of steer_lag"));
+  CHECK(contains(r.selection.selected, "steer_delay"));
+  CHECK_FALSE(contains(r.selection.selected, "steer_lag"));
+  CHECK(contains(r.selection.selected, "aero_drag"));
+  CHECK(r.selection.final_effects.steer_delay_s == Approx(0.1).margin(0.02));
+  std::filesystem::remove_all(dir);
+}
+
 TEST_CASE("a parameter at the end of its range in the joint refit is held at its nominal value", "[diagnose]") {
   auto problem = [](const DiagData& d) { return mppi::test::training_problem(d); };
   SECTION("one grade beyond the search range: held at 0, the other grade refitted") {
