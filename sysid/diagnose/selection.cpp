@@ -496,7 +496,12 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
         opt.progress("stability: resample " + std::to_string(++done) + " of " + std::to_string(opt.stability_resamples) + " done");
       }
     });
-    for (const auto& c : chosen) {
+    for (std::size_t b = 0; b < chosen.size(); ++b) {
+      const std::vector<int>& c = chosen[b];
+      const std::vector<std::string> ids = ids_of(cands, c);
+      std::string list;
+      for (const auto& id : ids) list += (list.empty() ? "" : ", ") + id;
+      log.push_back("stability: the resample #" + std::to_string(b + 1) + " chose " + (list.empty() ? "nothing" : list));
       for (int i : c) ++inclusion[static_cast<std::size_t>(i)];
       std::vector<std::string> families;  // the actuators whose dynamics this resample chose
       for (int i : c) {
