@@ -124,7 +124,9 @@ void swap_dynamics_forms(const Folds& folds, const std::vector<const EffectSpec*
     const EffectParams rest_effects = only(ids_of(cands, rest), base);
     for (int j : pool) {
       const EffectSpec& other = *cands[static_cast<std::size_t>(j)];
-      if (other.dynamics_of != current.dynamics_of || &other == cands[static_cast<std::size_t>(out.chosen[k])] ||
+      const double extra_params = static_cast<double>(other.params.size()) -
+                                  static_cast<double>(cands[static_cast<std::size_t>(out.chosen[k])]->params.size());
+      if (other.dynamics_of != current.dynamics_of || extra_params > 0.0 ||
           std::find(out.chosen.begin(), out.chosen.end(), j) != out.chosen.end())
         continue;
       std::vector<int> swapped = out.chosen;
@@ -132,11 +134,9 @@ void swap_dynamics_forms(const Folds& folds, const std::vector<const EffectSpec*
       FitResult trial = fit_effect(folds.fit, rest_effects, other);
       const FitResult joint = fit_params(folds.fit, trial.effects, joint_free_params(cands, swapped, trial.effects));
       if (joint.cost < trial.cost) trial = joint;
-      const double extra_params = static_cast<double>(other.params.size()) -
-                                  static_cast<double>(cands[static_cast<std::size_t>(out.chosen[k])]->params.size());
       const double bic = n_eff * std::log(trial.cost / fit_cost) + extra_params * std::log(n_eff);
       const double trial_val = mean_cost(folds.val, trial.effects);
-      if (!(bic < 0.0 && extra_params <= 0.0 && trial_val <= val_cost) ||
+      if (!(bic < 0.0 && trial_val <= val_cost) ||
           !range_limit_shortfall(other, trial.effects, opt.range_limit_margin).empty())
         continue;
       if (log) {
