@@ -187,6 +187,15 @@ FitResult fit_place_effect(const FitProblem& p, const EffectParams& base, const 
   return best;
 }
 
+FitResult fit_place_effect_from(const FitProblem& p, const EffectParams& base, const EffectSpec& spec,
+                                const EffectParams& start) {
+  EffectParams e = base;
+  for (const EffectParamSpec& q : spec.params) e.*(q.member) = start.*(q.member);
+  FitResult r = fit_params(p, e, active_params(spec, e), 10);
+  r.params = in_spec_order(spec, r);
+  return r;
+}
+
 double mean_cost(const FitProblem& p, const EffectParams& e) {
   std::vector<double> r;
   return residuals(p, e, &r);

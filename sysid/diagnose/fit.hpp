@@ -60,6 +60,11 @@ std::vector<ParamSpec> active_params(const EffectSpec& spec, const EffectParams&
 // further discs of the same surface added while each lowers the cost clearly.
 FitResult fit_place_effect(const FitProblem& p, const EffectParams& base, const EffectSpec& spec);
 
+// The same effect refined by least squares from a known place and shape (`start`'s values of the
+// effect's parameters; everything else from `base`), without the search.
+FitResult fit_place_effect_from(const FitProblem& p, const EffectParams& base, const EffectSpec& spec,
+                                const EffectParams& start);
+
 // One effect (spec) on top of base: start-value grid search, then LM.
 FitResult fit_effect(const FitProblem& p, const EffectParams& base, const EffectSpec& spec);
 

@@ -154,9 +154,16 @@ void swap_dynamics_forms(const Folds& folds, const std::vector<const EffectSpec*
   }
 }
 
+// `place_starts`: where given (a resample's selection), each place-dependent candidate is also
+// refined from the place that the selection on all the data found for it, and keeps the better
+// fit. A resample holds about two thirds of the data's blocks, fewer passes over the place, and
+// the search over places alone then lands on another place as often as not (a grip patch that
+// lowers the validation cost by 58 % on all the data found elsewhere, and worse, in 4 of 6
+// resamples): stability should ask whether the resample's data support the effect, not whether
+// a search from scratch finds it again.
 GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& cands, const Members& members,
                     const std::vector<int>& pool, const SelectionOptions& opt, double n_eff,
-                    SelectionLog* log) {
+                    SelectionLog* log, const std::vector<CandidateFit>* place_starts = nullptr) {
   const FitProblem& fit = folds.fit;
   const FitProblem& val = folds.val;
   GreedyResult out;
@@ -178,6 +185,12 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
       CandidateFit& c = tried[n];
       c.index = i;
       c.fit = fit_effect(fit, base, spec);
+      if (place_starts && spec.data_grid == DataGrid::kPlace)
+        for (const CandidateFit& s : *place_starts)
+          if (s.index == i) {
+            FitResult from_main = fit_place_effect_from(fit, base, spec, s.fit.effects);
+            if (from_main.cost < c.fit.cost) c.fit = std::move(from_main);
+          }
       c.val_cost = mean_cost(val, c.fit.effects);
       const double k = static_cast<double>(spec.params.size());
       c.bic = n_eff * std::log(c.fit.cost / base_fit) + k * std::log(n_eff);
@@ -490,7 +503,8 @@ Selection select_effects(const DiagData& d, const ModelFamily& nominal, const st
     std::mutex progress_mutex;
     int done = 0;
     tbb::parallel_for(std::size_t(0), resampled.size(), [&](std::size_t b) {
-      chosen[b] = greedy({resampled[b], val, early_fit, early_val}, cands, members, stable_pool, opt, n_eff, nullptr).chosen;
+      chosen[b] = greedy({resampled[b], val, early_fit, early_val}, cands, members, stable_pool, opt, n_eff, nullptr,
+                         &main.first_round).chosen;
       if (opt.progress) {
         std::lock_guard<std::mutex> lock(progress_mutex);
         opt.progress("stability: resample " + std::to_string(++done) + " of " + std::to_string(opt.stability_resamples) + " done");

@@ -51,3 +51,30 @@ TEST_CASE("a raised-cosine hill on the track is named as a ground bump at its pl
   CHECK(r.heldout_rmse_reduction > 0.3);
   std::filesystem::remove_all(dir);
 }
+
+// A low hill (0.25 m over a 12-m radius) crossed a few times by the human driver on Marietta: on
+// all the data the bump lowers the validation cost by about 10 %. Each stability resample holds
+// only part of the passes over it; a search over places from scratch found the hill elsewhere in
+// half of them, so it was left as "unstable". Refined from the place found on all the data, the
+// resamples judge whether their data support the hill there.
+TEST_CASE("a low hill found on all the data is stable across the resamples", "[diagnose][slow]") {
+  const auto dir = std::filesystem::temp_directory_path() / "mppi_ground_bump_stability_test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const evidence::EvidenceResult rec =
+      mppi::test::independent_recording(dir / "bump.csv", "bump_height_m=0.25,bump_radius_m=12", 4, "marietta", "cw", "human");
+  const DiagData d = load_recording(rec.csv);
+  DiagnoseOptions opt;
+  opt.plots = false;
+  const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track", rec.vehicle_yaml), opt);
+  std::string named;
+  for (const auto& s : r.selection.selected) named += s + " ";
+  double inclusion = 0;
+  for (const auto& c : r.selection.candidates)
+    if (c.id == "ground_bump") inclusion = c.inclusion_frequency;
+  INFO("named: " << named << "; ground_bump chosen in " << inclusion << " of the resamples");
+  CHECK(inclusion >= 0.8);
+  REQUIRE(r.selection.selected.size() == 1);
+  CHECK(r.selection.selected[0] == "ground_bump");
+  std::filesystem::remove_all(dir);
+}
