@@ -189,7 +189,12 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
         for (const CandidateFit& s : *place_starts)
           if (s.index == i) {
             FitResult from_main = fit_place_effect_from(fit, base, spec, s.fit.effects);
-            if (from_main.cost < c.fit.cost) c.fit = std::move(from_main);
+            // An identified fit is preferred to one with a parameter at its range's end (a third
+            // patch of all the data grown to the largest radius on a resample's fewer passes).
+            const bool main_identified = range_limit_shortfall(spec, from_main.effects, opt.range_limit_margin).empty();
+            const bool search_identified = range_limit_shortfall(spec, c.fit.effects, opt.range_limit_margin).empty();
+            if (main_identified != search_identified ? main_identified : from_main.cost < c.fit.cost)
+              c.fit = std::move(from_main);
           }
       c.val_cost = mean_cost(val, c.fit.effects);
       const double k = static_cast<double>(spec.params.size());
