@@ -4,8 +4,10 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <system_error>
 
 #include "sysid/diagnose/data.hpp"
+#include "sysid/diagnose/diagnose.hpp"
 #include "sysid/diagnose/fit.hpp"
 #include "sysid/diagnose/model_family.hpp"
 #include "sysid/evidence/generator.hpp"
@@ -39,6 +41,34 @@ inline evidence::EvidenceResult independent_recording(const std::filesystem::pat
   o.vehicle_yaml = data_path("config/autorally_single_track.yaml");
   o.truth_names = evidence::set_truth_effects(truth, &o.truth);
   return evidence::generate_evidence(o, csv.string());
+}
+
+// A fresh directory under the system's temporary directory, removed with what it holds at scope exit.
+class ScratchDir {
+ public:
+  explicit ScratchDir(const std::string& name) : path_(std::filesystem::temp_directory_path() / name) {
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  std::filesystem::path operator/(const std::string& file) const { return path_ / file; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// The diagnosis of an independent recording, its nominal the car the generator was built from
+// (as the sweep runs it), without plots.
+inline diagnose::DiagnoseResult diagnose_independent(const evidence::EvidenceResult& rec,
+                                                     diagnose::DiagnoseOptions opt = {}) {
+  opt.plots = false;
+  const diagnose::DiagData d = diagnose::load_recording(rec.csv);
+  return diagnose::run_diagnosis(d, *diagnose::make_model_family("single-track", rec.vehicle_yaml), opt);
 }
 
 }  // namespace mppi::test

@@ -38,16 +38,9 @@ TEST_CASE("the effect table groups the forms of each actuator's dynamics", "[dia
 // sharply: the resamples choose the play in 3 of 6 and a first-order lag in 2. Without the group,
 // neither is stable and nothing is named.
 TEST_CASE("a steering play that the resamples split with a lag is named as the steering's dynamics", "[diagnose][slow]") {
-  const auto dir = std::filesystem::temp_directory_path() / "mppi_actuator_dynamics_test";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  const evidence::EvidenceResult rec =
-      mppi::test::independent_recording(dir / "play.csv", "steer_backlash=0.1", 2, "ccrf", "ccw", "human");
-
-  const DiagData d = load_recording(rec.csv);
-  DiagnoseOptions opt;
-  opt.plots = false;
-  const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track", rec.vehicle_yaml), opt);
+  const mppi::test::ScratchDir dir("mppi_actuator_dynamics_test");
+  const DiagnoseResult r = mppi::test::diagnose_independent(
+      mppi::test::independent_recording(dir / "play.csv", "steer_backlash=0.1", 2, "ccrf", "ccw", "human"));
   std::string named, suspected;
   for (const auto& s : r.selection.selected) named += s + " ";
   for (const auto& s : r.selection.suspected) suspected += s.id + " (" + s.reason + "); ";
@@ -62,7 +55,6 @@ TEST_CASE("a steering play that the resamples split with a lag is named as the s
   REQUIRE(lag != r.selection.suspected.end());
   CHECK_THAT(lag->reason, Catch::Contains("another form of the steer's dynamics"));
   CHECK(r.heldout_rmse_reduction > 0.3);
-  std::filesystem::remove_all(dir);
 }
 
 // The independent generator's exact FIFO steering delay (0.1 s) beside drag along the velocity
@@ -71,18 +63,13 @@ TEST_CASE("a steering play that the resamples split with a lag is named as the s
 // speed) and is chosen first; once the drag is in the model the delay fits better, and the form is
 // swapped. Without the swap the lag is named.
 TEST_CASE("a steering delay chosen as a lag before the drag was in the model is swapped back to the delay", "[diagnose][slow]") {
-  const auto dir = std::filesystem::temp_directory_path() / "mppi_actuator_swap_test";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  const evidence::EvidenceResult rec = mppi::test::independent_recording(
-      dir / "delay_drag.csv", "steer_delay_s=0.1,extra_drag_kgpm=0.5", 2, "ccrf", "ccw", "human");
-
-  const DiagData d = load_recording(rec.csv);
+  const mppi::test::ScratchDir dir("mppi_actuator_swap_test");
   DiagnoseOptions opt;
-  opt.plots = false;
   opt.selection.candidates = {"aero_drag", "rolling_resistance", "steer_delay", "steer_lag", "steer_rate_limit", "steer_backlash"};
   opt.selection.stability_resamples = 0;
-  const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track", rec.vehicle_yaml), opt);
+  const DiagnoseResult r = mppi::test::diagnose_independent(
+      mppi::test::independent_recording(dir / "delay_drag.csv", "steer_delay_s=0.1,extra_drag_kgpm=0.5", 2, "ccrf", "ccw", "human"),
+      opt);
   std::string named, log;
   for (const auto& s : r.selection.selected) named += s + " ";
   for (const auto& l : r.selection.log) log += l + "\n";
@@ -93,7 +80,6 @@ TEST_CASE("a steering delay chosen as a lag before the drag was in the model is 
   CHECK_FALSE(contains(r.selection.selected, "steer_lag"));
   CHECK(contains(r.selection.selected, "aero_drag"));
   CHECK(r.selection.final_effects.steer_delay_s == Approx(0.1).margin(0.02));
-  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("a parameter at the end of its range in the joint refit is held at its nominal value", "[diagnose]") {

@@ -84,17 +84,11 @@ TEST_CASE("lost-control options out of range are refused by name", "[diagnose]")
 // in 40 s on Marietta. Fitted with the spins, every candidate bends towards them (a play of 0.3 at
 // its range limit, a delay of 0.15 s) and fails on the later data, so nothing is named.
 TEST_CASE("a steering play is named on a recording whose car spins before its crashes", "[diagnose][slow]") {
-  const auto dir = std::filesystem::temp_directory_path() / "mppi_control_loss_test";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const mppi::test::ScratchDir dir("mppi_control_loss_test");
   const evidence::EvidenceResult rec =
       mppi::test::independent_recording(dir / "spins.csv", "steer_backlash=0.1", 1, "marietta", "ccw", "pursuit");
   REQUIRE(rec.crashes >= 5);
-
-  const DiagData d = load_recording(rec.csv);
-  DiagnoseOptions opt;
-  opt.plots = false;
-  const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track", rec.vehicle_yaml), opt);
+  const DiagnoseResult r = mppi::test::diagnose_independent(rec);
   std::string named;
   for (const auto& s : r.selection.selected) named += s + " ";
   INFO("named: " << named << "; rows of lost control " << r.control_loss_rows << "; held-out reduction "
@@ -105,5 +99,4 @@ TEST_CASE("a steering play is named on a recording whose car spins before its cr
   // The fitted play is 0.14 (the slides that stay in the data, below the spin limit, widen it).
   CHECK(r.selection.final_effects.steer_backlash == Approx(0.1).margin(0.05));
   CHECK(r.heldout_rmse_reduction > 0.15);
-  std::filesystem::remove_all(dir);
 }

@@ -21,9 +21,7 @@ using namespace mppi;
 using namespace mppi::diagnose;
 
 TEST_CASE("a raised-cosine hill on the track is named as a ground bump at its place", "[diagnose][slow]") {
-  const auto dir = std::filesystem::temp_directory_path() / "mppi_ground_bump_test";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const mppi::test::ScratchDir dir("mppi_ground_bump_test");
   const evidence::EvidenceResult rec =
       mppi::test::independent_recording(dir / "bump.csv", "bump_height_m=0.6,bump_radius_m=12", 1, "gazebo", "ccw", "pursuit");
 
@@ -33,10 +31,7 @@ TEST_CASE("a raised-cosine hill on the track is named as a ground bump at its pl
   const auto& centre = truth.at("effects").at(0).at("sizes").at("centre_m");
   const double cx = centre.at(0).get<double>(), cy = centre.at(1).get<double>();
 
-  const DiagData d = load_recording(rec.csv);
-  DiagnoseOptions opt;
-  opt.plots = false;
-  const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track", rec.vehicle_yaml), opt);
+  const DiagnoseResult r = mppi::test::diagnose_independent(rec);
   std::string named;
   for (const auto& s : r.selection.selected) named += s + " ";
   const EffectParams& e = r.selection.final_effects;
@@ -49,7 +44,6 @@ TEST_CASE("a raised-cosine hill on the track is named as a ground bump at its pl
   CHECK(e.bump_radius_m == Approx(12.0).margin(1.5));
   CHECK(e.bump_height_m == Approx(0.6).margin(0.1));
   CHECK(r.heldout_rmse_reduction > 0.3);
-  std::filesystem::remove_all(dir);
 }
 
 // A low hill (0.25 m over a 12-m radius) crossed a few times by the human driver on Marietta: on
@@ -58,15 +52,9 @@ TEST_CASE("a raised-cosine hill on the track is named as a ground bump at its pl
 // half of them, so it was left as "unstable". Refined from the place found on all the data, the
 // resamples judge whether their data support the hill there.
 TEST_CASE("a low hill found on all the data is stable across the resamples", "[diagnose][slow]") {
-  const auto dir = std::filesystem::temp_directory_path() / "mppi_ground_bump_stability_test";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  const evidence::EvidenceResult rec =
-      mppi::test::independent_recording(dir / "bump.csv", "bump_height_m=0.25,bump_radius_m=12", 4, "marietta", "cw", "human");
-  const DiagData d = load_recording(rec.csv);
-  DiagnoseOptions opt;
-  opt.plots = false;
-  const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track", rec.vehicle_yaml), opt);
+  const mppi::test::ScratchDir dir("mppi_ground_bump_stability_test");
+  const DiagnoseResult r = mppi::test::diagnose_independent(
+      mppi::test::independent_recording(dir / "bump.csv", "bump_height_m=0.25,bump_radius_m=12", 4, "marietta", "cw", "human"));
   std::string named;
   for (const auto& s : r.selection.selected) named += s + " ";
   double inclusion = 0;
@@ -76,5 +64,4 @@ TEST_CASE("a low hill found on all the data is stable across the resamples", "[d
   CHECK(inclusion >= 0.8);
   REQUIRE(r.selection.selected.size() == 1);
   CHECK(r.selection.selected[0] == "ground_bump");
-  std::filesystem::remove_all(dir);
 }
