@@ -65,3 +65,20 @@ TEST_CASE("a low hill found on all the data is stable across the resamples", "[d
   REQUIRE(r.selection.selected.size() == 1);
   CHECK(r.selection.selected[0] == "ground_bump");
 }
+
+// Large grip patches (grip x 0.5) on Marietta, pursuit driver. Refined from the patches found on
+// all the data, a resample can grow a third disc to the largest radius (a range end) on its fewer
+// passes; where that fit was kept for its lower cost, the resample was left without the patch and
+// chose the tyre, and the tyre was named in place of the patch. The search's identified fit is
+// kept instead.
+TEST_CASE("a resample keeps an identified grip patch over a refit that ends at a range limit", "[diagnose][slow]") {
+  const mppi::test::ScratchDir dir("mppi_grip_patch_stability_test");
+  const DiagnoseResult r = mppi::test::diagnose_independent(
+      mppi::test::independent_recording(dir / "patches.csv", "grip_patch_scale=0.5", 1, "marietta", "ccw", "pursuit"));
+  std::string named, log;
+  for (const auto& s : r.selection.selected) named += s + " ";
+  for (const auto& l : r.selection.log) log += l + "\n";
+  INFO("named: " << named << "\n" << log);
+  CHECK(std::find(r.selection.selected.begin(), r.selection.selected.end(), "grip_patch") != r.selection.selected.end());
+  CHECK(std::find(r.selection.selected.begin(), r.selection.selected.end(), "tire_saturation") == r.selection.selected.end());
+}
