@@ -7,7 +7,8 @@
 // off at its default value, so WithEffects<M> with default EffectParams steps exactly like M
 // (plus the bookkeeping states). Each effect enters through its hook:
 //   - actuator: offsets, gains, steering map, delays, lags, rate limits, backlash and voltage
-//     sag transform the command first;
+//     sag transform the command first; a speed loop turns a speed command into the throttle
+//     from the driven wheels' rim speed;
 //   - chassis: tire_saturation, friction_change, grip_patch, load_transfer, payload and
 //     motor_speed change the base's single-track core parameters (apply_effect_params), with a
 //     second base model for the other grip: after a change (time is a state) or on the patch's
@@ -134,6 +135,10 @@ class WithEffects {
     throttle_gain_ = static_cast<float>(effects_.throttle_gain);
     thr_offset_ = static_cast<float>(effects_.throttle_offset);
     sag_ = static_cast<float>(effects_.voltage_sag);
+    speed_loop_ = effects_.speed_loop_top_speed_mps > 0.0;
+    loop_top_speed_mps_ = static_cast<float>(effects_.speed_loop_top_speed_mps);
+    loop_gain_per_mps_ = static_cast<float>(effects_.speed_loop_gain);
+    loop_feedforward_per_mps_ = static_cast<float>(1.0 / car.no_load_speed_mps);
   }
 
   const Base& nominal() const { return nominal_; }
@@ -174,6 +179,14 @@ class WithEffects {
   float applied_throttle(float t) const noexcept {
     const float t_pos = std::max(t, 0.f);
     return throttle_gain_ * t + thr_offset_ - sag_ * t_pos * t_pos;
+  }
+
+  // speed_loop: the throttle a low-level loop sets for the speed command u (the speed V u), from
+  // the driven wheels' rim speed: the throttle that holds V u on the DC-motor line without load
+  // (V u / v_nl) plus k (V u - v).
+  float speed_loop_throttle(float u, float rim_mps) const noexcept {
+    const float target_mps = loop_top_speed_mps_ * u;
+    return std::clamp(loop_feedforward_per_mps_ * target_mps + loop_gain_per_mps_ * (target_mps - rim_mps), -1.f, 1.f);
   }
 
   // motor_freewheel and drag_brake: the command u' that makes the base's motor law
@@ -218,12 +231,13 @@ class WithEffects {
         chain_t[i] = x[kThrottleChain + i][j];
       }
       const float s = advance_chain(chain_s, u[control::kSteer][j], k.steer);
-      const float t = advance_chain(chain_t, u[control::kThrottle][j], k.throttle);
+      float t = advance_chain(chain_t, u[control::kThrottle][j], k.throttle);
       for (int i = 0; i < kChain; ++i) {
         x[kSteerChain + i][j] = chain_s[i];
         x[kThrottleChain + i][j] = chain_t[i];
       }
       applied[control::kSteer * W + j] = applied_steer(s);
+      if (speed_loop_) t = speed_loop_throttle(t, motor_rim_speed<W>(x, j));
       applied[control::kThrottle * W + j] = applied_throttle(t);
       const float vx = x[state::kVx][j];
       float sy, cy;
@@ -381,6 +395,8 @@ class WithEffects {
   float gain_ = 1, offset_ = 0, steer_cubic_ = 0, left_gain_ = 1, right_gain_ = 1;  // steering map
   float throttle_gain_ = 1, thr_offset_ = 0, sag_ = 0;                              // throttle map
   bool esc_ = false;  // motor_freewheel, drag_brake
+  bool speed_loop_ = false;
+  float loop_top_speed_mps_ = 0, loop_gain_per_mps_ = 0, loop_feedforward_per_mps_ = 0;
   float freewheel_per_mps_ = 0, drag_brake_cmd_ = 0, brake_ratio_ = 1, inv_brake_ratio_ = 1, wheel_radius_ = 1;
   float front_drive_ = 0;  // the base's share of the drive on the front axle (after the effects)
 };

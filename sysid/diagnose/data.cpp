@@ -28,6 +28,12 @@ DiagData prepare(const sim::Recording& rec, const std::string& source, std::size
   d.control_lead = (src != rec.metadata.end() &&
                     (src->second == "mppi-sim" || src->second.rfind("mppi-fit synth", 0) == 0))
                        ? 1 : 0;
+  const auto command = rec.metadata.find("throttle_command");
+  if (command != rec.metadata.end()) {
+    if (command->second != "speed" && command->second != "throttle")
+      throw Error(source + ": metadata 'throttle_command: " + command->second + "': expected 'speed' or 'throttle'");
+    d.speed_command = command->second == "speed";
+  }
   const std::size_t n = d.t.size();
   min_rows = std::max<std::size_t>(min_rows, 2);  // the sample interval needs two rows
   if (n < min_rows)
@@ -113,6 +119,9 @@ DiagData load_recording(const std::string& path) {
 DiagData concat(const DiagData& a, const DiagData& b) {
   if (a.control_lead != b.control_lead)
     throw Error(a.source + " and " + b.source + ": recordings of different kinds (command timing) cannot be combined");
+  if (a.speed_command != b.speed_command)
+    throw Error(a.source + " and " + b.source + ": one declares its throttle column a speed command "
+                "('# throttle_command: speed'), the other not; they cannot be combined");
   DiagData d = a;
   d.source = a.source + " + " + b.source;
   const double shift = a.t.back() + 10.0 - b.t.front();

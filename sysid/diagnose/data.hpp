@@ -23,6 +23,9 @@ struct DiagData {
   // The command that acts over (t[k], t[k+1]]: index k + control_lead. mppi-sim logs hold in
   // row k+1 the command that produced it (lead 1); real recordings the command sent at t[k] (0).
   int control_lead = 0;
+  // The throttle column holds the stack's speed command, which a low-level loop in the car turns
+  // into throttle (the recording's metadata line `# throttle_command: speed`).
+  bool speed_command = false;
   std::vector<int> piece;                   // piece id per row (-1 = unusable row)
   // Values screened out (screen.hpp): each flag's row and its guard rows have piece -1.
   std::vector<ScreenFlag> flags;

@@ -74,7 +74,8 @@ std::vector<EvidenceCase> evidence_cases(const EvidenceGrid& g) {
   for (int s = 1; s <= g.seeds; ++s)
     for (const auto& size : g.sizes)
       for (const auto& info : truth_effect_catalogue()) {
-        if (!g.effects.empty() && std::find(g.effects.begin(), g.effects.end(), info.name) == g.effects.end()) continue;
+        const bool asked = std::find(g.effects.begin(), g.effects.end(), info.name) != g.effects.end();
+        if (g.effects.empty() ? !info.in_grid : !asked) continue;
         single.push_back({{info.name}, size, size == "small" ? info.small : info.large, s});
       }
   const int n_pairs = std::min<int>(g.pairs, static_cast<int>(pair_list().size()));

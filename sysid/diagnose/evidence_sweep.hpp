@@ -43,7 +43,7 @@ struct EvidenceRun {
 struct EvidenceGrid {
   int seeds = 5;
   std::vector<std::string> sizes = {"small", "large"};
-  std::vector<std::string> effects;  // empty = every catalogue effect
+  std::vector<std::string> effects;  // empty = every catalogue effect in the grid (TruthEffectInfo::in_grid)
   int pairs = 8;                     // 2-effect combinations (large sizes), from a fixed list
   int clean = 20;                    // effect-free recordings
   double duration_s = 60;

@@ -63,6 +63,7 @@ ExcitationLevels measure_excitation(const DiagData& d, const std::vector<char>& 
   x.speed_range_mps = percentile(vx, 0.95) - percentile(vx, 0.05);
   x.lateral_accel_p95_mps2 = percentile(ay, 0.95);
   x.longitudinal_accel_std_mps2 = stddev(ax);
+  x.speed_command = d.speed_command;
   return x;
 }
 
@@ -83,6 +84,10 @@ std::string excitation_shortfall(Excitation needs, const ExcitationLevels& x) {
         return format("no cornering towards the grip limit (95th percentile |ay| %.2f m/s^2 < %.1f)",
                       x.lateral_accel_p95_mps2, kMinLateralAccel);
       return "";
+    case Excitation::kSpeedCommand:
+      if (!x.speed_command)
+        return "the throttle column is not declared a speed command (metadata line '# throttle_command: speed')";
+      return excitation_shortfall(Excitation::kThrottle, x);
     case Excitation::kSpeedRange:
       if (x.speed_range_mps < kMinSpeedRange)
         return format("speed hardly varies (5-95 %% range %.2f m/s < %.1f)", x.speed_range_mps, kMinSpeedRange);

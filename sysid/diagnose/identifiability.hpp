@@ -19,6 +19,7 @@ struct ExcitationLevels {
   double speed_range_mps = 0;           // 95th - 5th percentile of vx [m/s]
   double lateral_accel_p95_mps2 = 0;    // 95th percentile of |vx r| [m/s^2]
   double longitudinal_accel_std_mps2 = 0;  // of dvx/dt over 0.1 s [m/s^2]
+  bool speed_command = false;           // the recording declares its throttle column a speed command
 };
 
 // Levels over the rows in `mask` (empty = all usable rows).

@@ -41,6 +41,15 @@ struct Battery {
   void draw(const CarConstants& c, double torque_Nm, double dt_s);
 };
 
+// A firmware speed loop (ESC / motor controller in speed mode): the command u asks for the speed
+// top_speed u; a PI controller on the motor's rim speed sets the throttle, its integral held
+// while the output is at a limit (anti-windup).
+struct SpeedLoop {
+  double top_speed_mps = 0, kp_per_mps = 0, ki_per_m = 0, integral = 0;
+  bool active() const { return top_speed_mps > 0; }
+  double throttle(double command, double rim_mps, double dt_s);
+};
+
 // All of the car's actuation for one physics step.
 class ActuatorChain {
  public:
@@ -58,6 +67,7 @@ class ActuatorChain {
   DelayLine steer_delay_, throttle_delay_;
   double servo_ = 0, wheel_ = 0;
   Battery battery_;
+  SpeedLoop speed_loop_;
 };
 
 }  // namespace mppi::evidence

@@ -213,10 +213,11 @@ EvidenceResult generate_evidence(const EvidenceOptions& o, const std::string& cs
   std::normal_distribution<double> n01(0, o.noise.scale);
   std::uniform_real_distribution<double> uni(0, 1);
   const auto& fx = o.truth;
-  const std::vector<std::pair<std::string, std::string>> meta = {
+  std::vector<std::pair<std::string, std::string>> meta = {
       {"source", "mppi-fit evidence (independent generator)"}, {"track", res.track},
       {"direction", res.direction}, {"driver", res.driver}, {"seed", std::to_string(o.seed)},
       {"command_timing", "row k: the command sent at t_k, held until the next row"}};
+  if (fx.speed_loop_top_speed_mps > 0) meta.emplace_back("throttle_command", "speed");
   std::filesystem::path parent = std::filesystem::path(csv_path).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent);
   res.csv = csv_path;

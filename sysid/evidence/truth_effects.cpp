@@ -19,6 +19,9 @@ const std::vector<std::pair<std::string, double TruthEffects::*>>& fields() {
       {"steer_offset", &TruthEffects::steer_offset},
       {"steer_cubic", &TruthEffects::steer_cubic},
       {"throttle_gain", &TruthEffects::throttle_gain},
+      {"speed_loop_top_speed_mps", &TruthEffects::speed_loop_top_speed_mps},
+      {"speed_loop_kp", &TruthEffects::speed_loop_kp},
+      {"speed_loop_ki", &TruthEffects::speed_loop_ki},
       {"battery_internal_resistance_fraction", &TruthEffects::battery_internal_resistance_fraction},
       {"battery_capacity_sag", &TruthEffects::battery_capacity_sag},
       {"extra_drag_kgpm", &TruthEffects::extra_drag_kgpm},
@@ -93,6 +96,10 @@ const std::vector<TruthEffectInfo>& truth_effect_catalogue() {
       {"sensor_time_offset", {"sensor_time_offset_s"}, {"time_offset"},
        "row at t holds the state of t - offset (negative: states logged before their commands)",
        "sensor_time_offset_s=-0.02", "sensor_time_offset_s=-0.06"},
+      {"speed_loop", {"speed_loop_top_speed_mps", "speed_loop_kp", "speed_loop_ki"}, {"speed_loop"},
+       "the throttle channel is a speed command (declared in the recording): the ESC's PI loop on the motor's "
+       "rim speed sets the throttle for the speed top_speed u",
+       "speed_loop_top_speed_mps=20", "speed_loop_top_speed_mps=10,speed_loop_kp=0.8,speed_loop_ki=2", false},
   };
   return c;
 }

@@ -15,6 +15,10 @@ struct TruthEffects {
   double steer_backlash = 0;      // play width between servo and wheels (normalised)
   double steer_gain = 1, steer_offset = 0, steer_cubic = 0;  // s -> g s + k s^3 + b
   double throttle_gain = 1;       // ESC gain
+  // A stack that commands speeds: the throttle channel asks for the speed top_speed u, and the
+  // ESC's PI loop (gains kp [1 per m/s], ki [1 per m]) on the motor's rim speed sets the throttle.
+  double speed_loop_top_speed_mps = 0;  // 0 = the channel is a throttle
+  double speed_loop_kp = 0.3, speed_loop_ki = 0.6;
   // Battery: terminal voltage = V_oc (1 - capacity_sag q / q_ref) - R I, with R I at stall
   // current = internal_resistance_fraction of V_nominal; q the charge used (stall-current
   // seconds), q_ref = 60 s. The motor torque follows the voltage.
@@ -49,6 +53,9 @@ struct TruthEffectInfo {
   std::vector<std::string> table_ids;   // acceptable ids; empty = out of library
   std::string form;                     // how it acts here, for the truth file
   std::string small, large;             // sweep sizes "key=value,..." (small = barely visible)
+  // In the sweep's grid unless false: the speed loop changes what the drivers' command means (a
+  // speed, declared in the recording), so it is run only when asked for (--effects).
+  bool in_grid = true;
 };
 const std::vector<TruthEffectInfo>& truth_effect_catalogue();
 const TruthEffectInfo& truth_effect_info(const std::string& name);  // throws mppi::Error

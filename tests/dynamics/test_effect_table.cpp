@@ -514,3 +514,46 @@ TEST_CASE("a drag brake decelerates the car by a_db at neutral command, and only
   bad.drag_brake_mps2 = -1.0;
   CHECK_THROWS_WITH(CorrectedSingleTrack(SingleTrack(p), bad), Catch::Contains("drag_brake_mps2"));
 }
+
+TEST_CASE("a speed loop sets the throttle V u / v_nl + k (V u - v) and holds the speed V u", "[effects]") {
+  SingleTrackParams p;  // the AutoRally car, without the resistances the closed form leaves out
+  p.rolling_resistance = 0.0;
+  p.aero_drag_kgpm = 0.0;
+  EffectParams e;
+  e.speed_loop_top_speed_mps = 10.0;
+  e.speed_loop_gain = 0.3;
+  const SingleTrack base(p);
+  const CorrectedSingleTrack loop(base, e);
+  SECTION("one step: the base model driven with the loop's throttle from the rim speed") {
+    for (const float v : {2.f, 5.f, 8.f}) {
+      for (const float u : {0.1f, 0.5f, -0.2f, 0.95f}) {
+        INFO("v " << v << " m/s, speed command " << u);
+        float xb[SingleTrack::kNx], xw[CorrectedSingleTrack::kNx];
+        start(base, xb, v);
+        start(loop, xw, v);
+        loop.set_actuators(xw, 0.f, u);
+        const float rim_mps = xb[SingleTrack::kOmegaRear] * static_cast<float>(p.wheel_radius_m);
+        const double target_mps = 10.0 * u;
+        const float throttle = static_cast<float>(
+            std::clamp(target_mps / p.no_load_speed_mps + 0.3 * (target_mps - rim_mps), -1.0, 1.0));
+        const float ub[2] = {0.f, throttle}, uw[2] = {0.f, u};
+        base.step<1>(Batch<SingleTrack::kNx, 1>{xb}, ConstBatch<2, 1>{ub}, 0.002f, nullptr);
+        loop.step<1>(Batch<CorrectedSingleTrack::kNx, 1>{xw}, ConstBatch<2, 1>{uw}, 0.002f, nullptr);
+        for (int i = 0; i < SingleTrack::kNx; ++i) CHECK(xw[i] == Approx(xb[i]).margin(1e-5));
+      }
+    }
+  }
+  SECTION("steady state: without resistances the DC-motor line's torque vanishes at v = V u") {
+    // T = T_stall (V u / v_nl + k (V u - v) - v / v_nl) = T_stall (1 / v_nl + k) (V u - v)
+    for (const float u : {0.3f, 0.6f}) {
+      CHECK(speed_after(loop, 2.f, u, 8.0) == Approx(10.0 * u).margin(0.02));
+      CHECK(std::abs(speed_after(base, 2.f, u, 8.0) - 10.0 * u) > 1.0);  // the bare command is a throttle
+    }
+  }
+  SECTION("off at its default: a top speed of 0") {
+    const float u[2] = {0.2f, 0.4f};
+    EffectParams off;
+    off.speed_loop_gain = 2.0;
+    CHECK(max_difference_after(SingleTrack(), CorrectedSingleTrack(SingleTrack(), off), u, u, 300) < 1e-6f);
+  }
+}
