@@ -65,7 +65,8 @@ std::vector<std::string> split_list(const std::string& s) {
 std::string usage() {
   std::string u = kEvidenceUsage;
   for (const auto& e : evidence::truth_effect_catalogue())
-    u += "  " + e.name + ": " + e.form + " (small " + e.small + ", large " + e.large + ")\n";
+    u += "  " + e.name + ": " + e.form + " (small " + e.small + ", large " + e.large + ")" +
+         (e.in_grid ? "" : " [not in the sweep's grid unless asked for: --effects " + e.name + "]") + "\n";
   return u;
 }
 

@@ -255,6 +255,14 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
       for (auto it = order.begin(); it != order.end(); ++it)
         if ((*it)->improvement >= near_best && params_of(*it) == params_of(front) && (*it)->bic < (*stronger)->bic) stronger = it;
       if ((*stronger)->bic <= front->bic - opt.strong_bic_evidence) std::rotate(order.begin(), stronger, stronger + 1);
+      // What the recording declares comes first: where the throttle column is a speed command,
+      // the speed loop (when it passes) is the model's structure and the others compete on top
+      // of it. A drive term that mimics the loop's feedforward (the motor's no-load speed scaled
+      // to V / v_nl) would otherwise win on simplicity and take its place.
+      const auto declared = std::find_if(order.begin(), order.end(), [&](const CandidateFit* c) {
+        return cands[static_cast<std::size_t>(c->index)]->needs == Excitation::kSpeedCommand;
+      });
+      if (declared != order.end()) std::rotate(order.begin(), declared, declared + 1);
     }
     const CandidateFit* pick = nullptr;
     for (const CandidateFit* c : order) {

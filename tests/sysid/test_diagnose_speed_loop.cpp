@@ -80,9 +80,13 @@ TEST_CASE("the sweep's grid leaves the speed loop out unless it is asked for", "
         }) == asked.seeds * 2);  // each seed at both sizes
 }
 
+// The human-like driver on Marietta: a no-load speed scaled to V / v_nl (the loop's feedforward
+// alone, one parameter) lowers the validation cost nearly as much as the loop (96.5 % against
+// 98.9 %) and took its place on simplicity, with a throttle gain, offset and time offset beside
+// it. What the recording declares now comes first.
 TEST_CASE("a PI speed loop in the car is named as the speed loop, with its top speed", "[diagnose][slow]") {
   const mppi::test::ScratchDir dir("mppi_speed_loop_test");
-  const auto rec = mppi::test::independent_recording(dir / "loop.csv", kLargeLoop, 1, "marietta", "ccw", "pursuit");
+  const auto rec = mppi::test::independent_recording(dir / "loop.csv", kLargeLoop, 4, "marietta", "cw", "human");
   const DiagnoseResult r = mppi::test::diagnose_independent(rec);
   std::string named;
   for (const auto& s : r.selection.selected) named += s + " ";
