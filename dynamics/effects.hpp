@@ -23,9 +23,10 @@
 //             steer_backlash              play of width b between servo and wheels
 //             speed_loop                  the throttle channel carries a speed command: the car's
 //                                         low-level loop asks for the speed V u and sets the
-//                                         throttle V u / v_nl + k (V u - v) (feedforward from the
-//                                         motor's no-load speed v_nl, proportional on the driven
-//                                         wheels' rim speed v), clamped to [-1, 1]. Only for
+//                                         throttle V u / v_nl + k e + k_i int e dt, e = V u - v
+//                                         (feedforward from the motor's no-load speed v_nl, PI on
+//                                         the driven wheels' rim speed v; the integral held while
+//                                         the throttle is at +-1), clamped to [-1, 1]. Only for
 //                                         recordings that declare a speed command
 //   chassis:  tire_saturation             Magic Formula peak D -> k D, B -> s B / k
 //             friction_change             grip (D, Sv) x g from time t_change on
@@ -137,6 +138,7 @@ struct EffectParams {
   double bump_height_m = 0.0;        // [m] its height at the centre (negative: a dip; 0 = none)
   double speed_loop_top_speed_mps = 0.0;  // [m/s] V: the command u asks for the speed V u (0 = no loop)
   double speed_loop_gain = 0.5;      // [1 per m/s] k: throttle per m/s of speed error
+  double speed_loop_integral_gain = 0.0;  // [1 per m] k_i: throttle per m of integrated speed error
 
   bool is_valid(std::string* why) const;
 };
@@ -295,9 +297,11 @@ inline const std::vector<EffectSpec>& effect_table() {
        {{"speed_scale", &E::speed_scale, "1", kScale, 0.5, 1.5, 0.02}}, {}, DataGrid::kNone, X::kAny},
       {"time_offset", "sensor fault: states stamped t late against the commands (negative: early)", H::kSensor,
        {{"time_offset_s", &E::time_offset_s, "s", open(-0.5, 0.5), -0.3, 0.0, 0.01}}, {-0.1, -0.04}, DataGrid::kNone, X::kSteer},
-      {"speed_loop", "the throttle channel is a speed command: a loop sets the throttle V u / v_nl + k (V u - v)", H::kActuator,
+      {"speed_loop", "the throttle channel is a speed command: a PI loop sets the throttle V u / v_nl + k e + k_i int e, e = V u - v",
+       H::kActuator,
        {{"speed_loop_top_speed_mps", &E::speed_loop_top_speed_mps, "m/s (at full command)", kNonNeg, 0.0, 40.0, 1.0},
-        {"speed_loop_gain", &E::speed_loop_gain, "1 per m/s", positive(), 0.02, 5.0, 0.1}},
+        {"speed_loop_gain", &E::speed_loop_gain, "1 per m/s", positive(), 0.02, 5.0, 0.1},
+        {"speed_loop_integral_gain", &E::speed_loop_integral_gain, "1 per m", kNonNeg, 0.0, 20.0, 0.2}},
        {4.0, 8.0, 15.0}, DataGrid::kNone, X::kSpeedCommand},
   };
   return table;

@@ -25,7 +25,7 @@
 //     (SingleTrackParams defaults; the network models that car).
 // State: the base's kNx, then time [s], then the steer and throttle actuator chains
 // (kActuatorDelayStages delay stages, one lag stage with the rate limit, one play stage for the
-// backlash, whose output is applied).
+// backlash, whose output is applied), then the speed loop's integral of its speed error [m].
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -75,7 +75,8 @@ class WithEffects {
   static constexpr int kTime = Base::kNx;
   static constexpr int kSteerChain = kTime + 1;
   static constexpr int kThrottleChain = kSteerChain + kChain;
-  static constexpr int kNx = kThrottleChain + kChain;
+  static constexpr int kSpeedLoopIntegral = kThrottleChain + kChain;
+  static constexpr int kNx = kSpeedLoopIntegral + 1;
   static constexpr int kNu = 2;
   static constexpr int kOmega = [] {  // wheel speeds, as in the base (-1: none)
     if constexpr (requires { Base::kOmega; }) return Base::kOmega;
@@ -138,6 +139,7 @@ class WithEffects {
     speed_loop_ = effects_.speed_loop_top_speed_mps > 0.0;
     loop_top_speed_mps_ = static_cast<float>(effects_.speed_loop_top_speed_mps);
     loop_gain_per_mps_ = static_cast<float>(effects_.speed_loop_gain);
+    loop_integral_gain_per_m_ = static_cast<float>(effects_.speed_loop_integral_gain);
     loop_feedforward_per_mps_ = static_cast<float>(1.0 / car.no_load_speed_mps);
   }
 
@@ -182,11 +184,17 @@ class WithEffects {
   }
 
   // speed_loop: the throttle a low-level loop sets for the speed command u (the speed V u), from
-  // the driven wheels' rim speed: the throttle that holds V u on the DC-motor line without load
-  // (V u / v_nl) plus k (V u - v).
-  float speed_loop_throttle(float u, float rim_mps) const noexcept {
+  // the driven wheels' rim speed v: the throttle that holds V u on the DC-motor line without load
+  // (V u / v_nl), plus k e + k_i (integral of e), e = V u - v. The integral [m] advances by e dt
+  // unless that would take the throttle past +-1 (anti-windup).
+  float speed_loop_throttle(float u, float rim_mps, float* integral_m, float dt_s) const noexcept {
     const float target_mps = loop_top_speed_mps_ * u;
-    return std::clamp(loop_feedforward_per_mps_ * target_mps + loop_gain_per_mps_ * (target_mps - rim_mps), -1.f, 1.f);
+    const float error_mps = target_mps - rim_mps;
+    const float without_integral = loop_feedforward_per_mps_ * target_mps + loop_gain_per_mps_ * error_mps;
+    const float wound_m = *integral_m + error_mps * dt_s;
+    const float wound = without_integral + loop_integral_gain_per_m_ * wound_m;
+    if (wound > -1.f && wound < 1.f) *integral_m = wound_m;
+    return std::clamp(without_integral + loop_integral_gain_per_m_ * *integral_m, -1.f, 1.f);
   }
 
   // motor_freewheel and drag_brake: the command u' that makes the base's motor law
@@ -237,7 +245,7 @@ class WithEffects {
         x[kThrottleChain + i][j] = chain_t[i];
       }
       applied[control::kSteer * W + j] = applied_steer(s);
-      if (speed_loop_) t = speed_loop_throttle(t, motor_rim_speed<W>(x, j));
+      if (speed_loop_) t = speed_loop_throttle(t, motor_rim_speed<W>(x, j), &x[kSpeedLoopIntegral][j], dt_s);
       applied[control::kThrottle * W + j] = applied_throttle(t);
       const float vx = x[state::kVx][j];
       float sy, cy;
@@ -396,7 +404,7 @@ class WithEffects {
   float throttle_gain_ = 1, thr_offset_ = 0, sag_ = 0;                              // throttle map
   bool esc_ = false;  // motor_freewheel, drag_brake
   bool speed_loop_ = false;
-  float loop_top_speed_mps_ = 0, loop_gain_per_mps_ = 0, loop_feedforward_per_mps_ = 0;
+  float loop_top_speed_mps_ = 0, loop_gain_per_mps_ = 0, loop_integral_gain_per_m_ = 0, loop_feedforward_per_mps_ = 0;
   float freewheel_per_mps_ = 0, drag_brake_cmd_ = 0, brake_ratio_ = 1, inv_brake_ratio_ = 1, wheel_radius_ = 1;
   float front_drive_ = 0;  // the base's share of the drive on the front axle (after the effects)
 };

@@ -515,7 +515,24 @@ TEST_CASE("a drag brake decelerates the car by a_db at neutral command, and only
   CHECK_THROWS_WITH(CorrectedSingleTrack(SingleTrack(p), bad), Catch::Contains("drag_brake_mps2"));
 }
 
-TEST_CASE("a speed loop sets the throttle V u / v_nl + k (V u - v) and holds the speed V u", "[effects]") {
+namespace {
+
+// The driven (rear) wheels' rim speed [m/s] after driving straight for `seconds` at command u
+// from 2 m/s.
+double rim_speed_after(const CorrectedSingleTrack& m, const SingleTrackParams& car, float u, double seconds) {
+  std::vector<float> x(CorrectedSingleTrack::kNx, 0.f);
+  VehicleState s;
+  s.vx_mps = 2.f;
+  m.init_state(s, x.data());
+  const float cmd[2] = {0.f, u};
+  for (int i = 0; i < static_cast<int>(seconds / 0.002 + 0.5); ++i)
+    m.step<1>(Batch<CorrectedSingleTrack::kNx, 1>{x.data()}, ConstBatch<2, 1>{cmd}, 0.002f, nullptr);
+  return x[SingleTrack::kOmegaRear] * car.wheel_radius_m;
+}
+
+}  // namespace
+
+TEST_CASE("a speed loop sets the throttle V u / v_nl + k e + k_i int e and holds the speed V u", "[effects]") {
   SingleTrackParams p;  // the AutoRally car, without the resistances the closed form leaves out
   p.rolling_resistance = 0.0;
   p.aero_drag_kgpm = 0.0;
@@ -549,6 +566,38 @@ TEST_CASE("a speed loop sets the throttle V u / v_nl + k (V u - v) and holds the
       CHECK(speed_after(loop, 2.f, u, 8.0) == Approx(10.0 * u).margin(0.02));
       CHECK(std::abs(speed_after(base, 2.f, u, 8.0) - 10.0 * u) > 1.0);  // the bare command is a throttle
     }
+  }
+  SECTION("with the car's resistances, the integral takes the steady-state error away") {
+    // Rolling resistance and drag need a throttle beyond the feedforward: a proportional loop
+    // settles where k e pays for them (e > 0); with k_i > 0 it settles only where e = 0. The loop
+    // measures the driven wheels' rim speed, which the tyre's drive slip keeps above v_x.
+    const SingleTrackParams car;
+    EffectParams pi = e;
+    pi.speed_loop_integral_gain = 1.5;
+    const float u = 0.5f;
+    CHECK(rim_speed_after(CorrectedSingleTrack(SingleTrack(car), pi), car, u, 25.0) == Approx(10.0 * u).margin(0.02));
+    CHECK(10.0 * u - rim_speed_after(CorrectedSingleTrack(SingleTrack(car), e), car, u, 25.0) > 0.1);
+  }
+  SECTION("the integral holds while the throttle is at its limit (anti-windup)") {
+    // From rest a command of 0.9 asks for 9 m/s: the throttle saturates at 1 and the integral
+    // must not grow meanwhile, or the speed would overshoot V u by far.
+    EffectParams pi = e;
+    pi.speed_loop_integral_gain = 3.0;
+    const SingleTrackParams car;
+    const CorrectedSingleTrack m(SingleTrack(car), pi);
+    std::vector<float> x(CorrectedSingleTrack::kNx, 0.f);
+    VehicleState s;
+    s.vx_mps = 0.5f;
+    m.init_state(s, x.data());
+    const float cmd[2] = {0.f, 0.9f};
+    auto rim_mps = [&] { return x[SingleTrack::kOmegaRear] * static_cast<float>(car.wheel_radius_m); };
+    float top_mps = 0;
+    for (int i = 0; i < 10000; ++i) {
+      m.step<1>(Batch<CorrectedSingleTrack::kNx, 1>{x.data()}, ConstBatch<2, 1>{cmd}, 0.002f, nullptr);
+      top_mps = std::max(top_mps, rim_mps());
+    }
+    CHECK(top_mps < 9.0 + 0.3);
+    CHECK(rim_mps() == Approx(9.0).margin(0.03));
   }
   SECTION("off at its default: a top speed of 0") {
     const float u[2] = {0.2f, 0.4f};
