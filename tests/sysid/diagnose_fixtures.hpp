@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <string>
 #include <system_error>
+#include <vector>
 
 #include "sysid/diagnose/data.hpp"
 #include "sysid/diagnose/diagnose.hpp"
@@ -41,6 +42,13 @@ inline evidence::EvidenceResult independent_recording(const std::filesystem::pat
   o.vehicle_yaml = data_path("config/autorally_single_track.yaml");
   o.truth_names = evidence::set_truth_effects(truth, &o.truth);
   return evidence::generate_evidence(o, csv.string());
+}
+
+// The ids, each followed by a space (for a test's messages): "grip_patch steer_delay ".
+inline std::string joined(const std::vector<std::string>& ids) {
+  std::string out;
+  for (const auto& id : ids) out += id + " ";
+  return out;
 }
 
 // A fresh directory under the system's temporary directory, removed with what it holds at scope exit.

@@ -41,8 +41,8 @@ TEST_CASE("a steering play that the resamples split with a lag is named as the s
   const mppi::test::ScratchDir dir("mppi_actuator_dynamics_test");
   const DiagnoseResult r = mppi::test::diagnose_independent(
       mppi::test::independent_recording(dir / "play.csv", "steer_backlash=0.1", 2, "ccrf", "ccw", "human"));
-  std::string named, suspected;
-  for (const auto& s : r.selection.selected) named += s + " ";
+  const std::string named = mppi::test::joined(r.selection.selected);
+  std::string suspected;
   for (const auto& s : r.selection.suspected) suspected += s.id + " (" + s.reason + "); ";
   INFO("named: " << named << "; suspected: " << suspected << "; held-out reduction " << r.heldout_rmse_reduction);
   CHECK(contains(r.selection.selected, "steer_backlash"));
@@ -70,8 +70,8 @@ TEST_CASE("a steering delay chosen as a lag before the drag was in the model is 
   const DiagnoseResult r = mppi::test::diagnose_independent(
       mppi::test::independent_recording(dir / "delay_drag.csv", "steer_delay_s=0.1,extra_drag_kgpm=0.5", 2, "ccrf", "ccw", "human"),
       opt);
-  std::string named, log;
-  for (const auto& s : r.selection.selected) named += s + " ";
+  const std::string named = mppi::test::joined(r.selection.selected);
+  std::string log;
   for (const auto& l : r.selection.log) log += l + "\n";
   INFO("named: " << named << "\n" << log);
   CHECK_THAT(log, Catch::Contains("round 1: selected steer_lag"));  // the situation the swap is for

@@ -89,8 +89,7 @@ TEST_CASE("a steering play is named on a recording whose car spins before its cr
       mppi::test::independent_recording(dir / "spins.csv", "steer_backlash=0.1", 1, "marietta", "ccw", "pursuit");
   REQUIRE(rec.crashes >= 5);
   const DiagnoseResult r = mppi::test::diagnose_independent(rec);
-  std::string named;
-  for (const auto& s : r.selection.selected) named += s + " ";
+  const std::string named = mppi::test::joined(r.selection.selected);
   INFO("named: " << named << "; rows of lost control " << r.control_loss_rows << "; held-out reduction "
                  << r.heldout_rmse_reduction);
   CHECK(r.control_loss_rows > 100);

@@ -32,8 +32,7 @@ TEST_CASE("a raised-cosine hill on the track is named as a ground bump at its pl
   const double cx = centre.at(0).get<double>(), cy = centre.at(1).get<double>();
 
   const DiagnoseResult r = mppi::test::diagnose_independent(rec);
-  std::string named;
-  for (const auto& s : r.selection.selected) named += s + " ";
+  const std::string named = mppi::test::joined(r.selection.selected);
   const EffectParams& e = r.selection.final_effects;
   INFO("named: " << named << "; truth centre (" << cx << ", " << cy << "); fitted (" << e.bump_x_m << ", "
                  << e.bump_y_m << "), radius " << e.bump_radius_m << ", height " << e.bump_height_m
@@ -55,8 +54,7 @@ TEST_CASE("a low hill found on all the data is stable across the resamples", "[d
   const mppi::test::ScratchDir dir("mppi_ground_bump_stability_test");
   const DiagnoseResult r = mppi::test::diagnose_independent(
       mppi::test::independent_recording(dir / "bump.csv", "bump_height_m=0.25,bump_radius_m=12", 4, "marietta", "cw", "human"));
-  std::string named;
-  for (const auto& s : r.selection.selected) named += s + " ";
+  const std::string named = mppi::test::joined(r.selection.selected);
   double inclusion = 0;
   for (const auto& c : r.selection.candidates)
     if (c.id == "ground_bump") inclusion = c.inclusion_frequency;
@@ -75,8 +73,8 @@ TEST_CASE("a resample keeps an identified grip patch over a refit that ends at a
   const mppi::test::ScratchDir dir("mppi_grip_patch_stability_test");
   const DiagnoseResult r = mppi::test::diagnose_independent(
       mppi::test::independent_recording(dir / "patches.csv", "grip_patch_scale=0.5", 1, "marietta", "ccw", "pursuit"));
-  std::string named, log;
-  for (const auto& s : r.selection.selected) named += s + " ";
+  const std::string named = mppi::test::joined(r.selection.selected);
+  std::string log;
   for (const auto& l : r.selection.log) log += l + "\n";
   INFO("named: " << named << "\n" << log);
   CHECK(std::find(r.selection.selected.begin(), r.selection.selected.end(), "grip_patch") != r.selection.selected.end());

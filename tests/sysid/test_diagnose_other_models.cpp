@@ -14,6 +14,7 @@
 #include "sysid/diagnose/diagnose.hpp"
 #include "sysid/diagnose/model_family.hpp"
 #include "sysid/diagnose/synth.hpp"
+#include "diagnose_fixtures.hpp"
 
 using namespace mppi;
 using namespace mppi::diagnose;
@@ -151,8 +152,7 @@ static void check_other_nominal(const char* model, const char* truth_text) {
   o.plots = false;
   const auto family = make_model_family(model);
   const DiagnoseResult r = run_diagnosis(d, *family, o);
-  std::string named;
-  for (const auto& s : r.selection.selected) named += s + " ";
+  const std::string named = mppi::test::joined(r.selection.selected);
   INFO(model << " truth '" << truth_text << "': named " << named << ", held-out reduction " << r.heldout_rmse_reduction);
   if (ids.empty()) {
     CHECK(r.selection.selected.empty());

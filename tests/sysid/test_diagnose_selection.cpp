@@ -18,6 +18,7 @@
 #include "sysid/diagnose/joint_refit.hpp"
 #include "sysid/diagnose/synth.hpp"
 #include "dynamics/single_track.hpp"
+#include "diagnose_fixtures.hpp"
 #include <random>
 
 #include <tbb/global_control.h>
@@ -57,8 +58,7 @@ static void check_named_alone(const char* truth) {
   for (std::uint64_t seed : {21u, 22u}) {
     std::vector<std::string> ids;
     const DiagnoseResult r = diagnose_synthetic(truth, seed, &ids);
-    std::string named;
-    for (const auto& s : r.selection.selected) named += s + " ";
+    const std::string named = mppi::test::joined(r.selection.selected);
     INFO(truth << " seed " << seed << ": named " << named << ", held-out reduction " << r.heldout_rmse_reduction);
     REQUIRE(!r.selection.selected.empty());
     CHECK(r.selection.selected[0] == ids[0]);
@@ -312,8 +312,7 @@ TEST_CASE("a patch of low grip is named as a place, not as a change in time", "[
   DiagnoseOptions o;
   o.plots = false;
   const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track"), o);
-  std::string named;
-  for (const auto& s : r.selection.selected) named += s + " ";
+  const std::string named = mppi::test::joined(r.selection.selected);
   INFO("named: " << named << "; held-out reduction " << r.heldout_rmse_reduction);
   REQUIRE_FALSE(r.selection.selected.empty());
   CHECK(r.selection.selected[0] == "grip_patch");
@@ -368,8 +367,7 @@ TEST_CASE("two patches of one low-grip surface are named as one grip patch with 
   DiagnoseOptions o;
   o.plots = false;
   const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track"), o);
-  std::string named;
-  for (const auto& s : r.selection.selected) named += s + " ";
+  const std::string named = mppi::test::joined(r.selection.selected);
   const EffectParams& e = r.selection.final_effects;
   INFO("named: " << named << "; discs (" << e.patch_x_m << ", " << e.patch_y_m << ", r " << e.patch_radius_m
                  << "), (" << e.patch2_x_m << ", " << e.patch2_y_m << ", r " << e.patch2_radius_m << "), r3 "

@@ -88,8 +88,7 @@ TEST_CASE("a PI speed loop in the car is named as the speed loop, with its top s
   const mppi::test::ScratchDir dir("mppi_speed_loop_test");
   const auto rec = mppi::test::independent_recording(dir / "loop.csv", kLargeLoop, 4, "marietta", "cw", "human");
   const DiagnoseResult r = mppi::test::diagnose_independent(rec);
-  std::string named;
-  for (const auto& s : r.selection.selected) named += s + " ";
+  const std::string named = mppi::test::joined(r.selection.selected);
   const EffectParams& e = r.selection.final_effects;
   INFO("named: " << named << "; top speed " << e.speed_loop_top_speed_mps << " m/s, gain " << e.speed_loop_gain
                  << "; held-out reduction " << r.heldout_rmse_reduction);
