@@ -41,7 +41,8 @@ double median(std::vector<double> v) {
 
 std::string pct(int n, int of) {
   char b[48];
-  std::snprintf(b, sizeof b, "%d/%d (%.0f %%)", n, of, of ? 100.0 * n / of : 0.0);
+  // One decimal: 206/230 is 89.6 %, short of a 90 % bar, not "90 %".
+  std::snprintf(b, sizeof b, "%d/%d (%.1f %%)", n, of, of ? 100.0 * n / of : 0.0);
   return b;
 }
 

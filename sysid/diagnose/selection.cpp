@@ -17,6 +17,7 @@
 #include "sysid/diagnose/fit.hpp"
 #include "sysid/diagnose/identifiability.hpp"
 #include "sysid/diagnose/joint_refit.hpp"
+#include "sysid/diagnose/ranking.hpp"
 
 namespace mppi::diagnose {
 namespace {
@@ -235,26 +236,13 @@ GreedyResult greedy(const Folds& folds, const std::vector<const EffectSpec*>& ca
     if (order.empty())
       for (const auto& c : tried)
         if (c.passes) order.push_back(&c);
-    // Ranked by how much they help on later data; among those within parsimony_share of the
-    // best, the one with the fewest parameters the data use comes first (c v^2 over F0 + b v on a
-    // speed range; F0 alone ties with c v^2 and the better one wins).
-    std::sort(order.begin(), order.end(),
-              [](const CandidateFit* a, const CandidateFit* b) { return a->improvement > b->improvement; });
     if (!order.empty()) {
-      const double near_best = opt.parsimony_share * order.front()->improvement;
-      auto params_of = [&](const CandidateFit* c) { return used_param_count(*cands[static_cast<std::size_t>(c->index)], c->fit); };
-      std::stable_sort(order.begin(), order.end(), [&](const CandidateFit* a, const CandidateFit* b) {
-        const bool na = a->improvement >= near_best, nb = b->improvement >= near_best;
-        if (na != nb) return na;
-        return na && params_of(a) < params_of(b);
-      });
-      // Between near-best candidates of as many parameters, the validation difference is within
-      // its noise; strong evidence on the fit part (more data: a BIC lower by >= 6) decides.
-      const CandidateFit* front = order.front();
-      auto stronger = order.begin();
-      for (auto it = order.begin(); it != order.end(); ++it)
-        if ((*it)->improvement >= near_best && params_of(*it) == params_of(front) && (*it)->bic < (*stronger)->bic) stronger = it;
-      if ((*stronger)->bic <= front->bic - opt.strong_bic_evidence) std::rotate(order.begin(), stronger, stronger + 1);
+      std::vector<RankedCandidate> ranked;
+      for (const CandidateFit* c : order)
+        ranked.push_back({c->improvement, c->bic, used_param_count(*cands[static_cast<std::size_t>(c->index)], c->fit)});
+      const std::vector<const CandidateFit*> unranked = order;
+      const std::vector<std::size_t> rank = rank_passing_candidates(ranked, opt.parsimony_share, opt.strong_bic_evidence);
+      for (std::size_t k = 0; k < rank.size(); ++k) order[k] = unranked[rank[k]];
       // What the recording declares comes first: where the throttle column is a speed command,
       // the speed loop (when it passes) is the model's structure and the others compete on top
       // of it. A drive term that mimics the loop's feedforward (the motor's no-load speed scaled
