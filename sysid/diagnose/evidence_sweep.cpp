@@ -41,7 +41,7 @@ double median(std::vector<double> v) {
 
 std::string pct(int n, int of) {
   char b[48];
-  // One decimal: 206/230 is 89.6 %, short of a 90 % bar, not "90 %".
+  // One decimal, so that a share just below a round figure is not shown as it (206/230: 89.6 %).
   std::snprintf(b, sizeof b, "%d/%d (%.1f %%)", n, of, of ? 100.0 * n / of : 0.0);
   return b;
 }
