@@ -265,8 +265,10 @@ inline const std::vector<EffectSpec>& effect_table() {
         {"grade_y", &E::grade_y, "1 (dz/dy)", kGrade, -0.3, 0.3, 0.01}}, {}, DataGrid::kNone, X::kAny},
       {"throttle_gain", "motor / ESC gain: throttle u -> g u", H::kActuator,
        {{"throttle_gain", &E::throttle_gain, "1", kScale, 0.3, 2.5, 0.1}}, {0.7, 1.0, 1.4}, DataGrid::kNone, X::kThrottle},
+      // k is searched down to -0.9: a fit of a soft linkage (k = -0.4) that also takes up other
+      // large-steer errors can end below -0.6, and a fit at the range's end is only a bound.
       {"steer_cubic", "nonlinear steering linkage: s -> s + k s^3", H::kActuator,
-       {{"steer_cubic", &E::steer_cubic, "1", open(-1.0, 2.0), -0.6, 1.0, 0.1}}, {-0.3, 0.3}, DataGrid::kNone, X::kSteer},
+       {{"steer_cubic", &E::steer_cubic, "1", open(-1.0, 2.0), -0.9, 1.0, 0.1}}, {-0.3, 0.3}, DataGrid::kNone, X::kSteer},
       {"steer_asymmetry", "left and right steering gains differ: x (1 + a) left, x (1 - a) right", H::kActuator,
        {{"steer_asymmetry", &E::steer_asymmetry, "1", open(-0.9, 0.9), -0.4, 0.4, 0.05}}, {}, DataGrid::kNone, X::kSteer},
       {"steer_rate_limit", "steering servo speed: the applied steer needs T seconds per unit of change", H::kActuator,
