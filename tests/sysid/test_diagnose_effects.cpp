@@ -128,6 +128,16 @@ TEST_CASE("each candidate effect's fit recovers the truth it was generated with"
   }
 }
 
+TEST_CASE("a soft steering linkage is fitted inside the cubic map's search range", "[diagnose]") {
+  // k = -0.75 lies beyond -0.6, where the search used to end (a fit there is only a bound).
+  EffectParams truth;
+  truth.steer_cubic = -0.75;
+  const DiagData d = prepare(synthesize_open_loop(truth, 11, 30.0), "steer_cubic_soft");
+  const FitResult r = fit_effect(problem_for(d), EffectParams{}, effect_spec("steer_cubic"));
+  CHECK(value_of(r, "steer_cubic") == Approx(-0.75).margin(0.1));
+  CHECK(value_of(r, "steer_cubic") > effect_spec("steer_cubic").params[0].lo);
+}
+
 TEST_CASE("recordings that cannot be diagnosed are rejected with the reason", "[diagnose]") {
   std::istringstream missing("t,x,y,yaw,vx,vy,yaw_rate,steer\n0,0,0,0,0,0,0,0\n");
   CHECK_THROWS_WITH(prepare(sim::RecordingReader::read(missing, "m.csv"), "m.csv"),
