@@ -42,6 +42,11 @@ const char* kCalibrateUsage = R"(usage: mppi-fit calibrate [options]
   --train-s S          training command sequence length                     (100)
   --heldout-s S        held-out command sequence length                     (100)
   --seed N             training seed; the held-out sequence uses N + 1000   (1)
+  --train-log FILE     also fit to this recording of the learned model (e.g. an mppi-sim
+                       log.csv with --plant autorally-nn: closed-loop driving at the operating
+                       point); repeatable. Logs with applied_steer / applied_throttle columns
+                       are read with those as the commands (what the car received)
+  --heldout-log FILE   also judge on this recording (a second table, fit_logs.md); repeatable
   --dither S,T         white noise (std) added to every steering / throttle
                        command of both sequences, as MPPI's applied commands
                        carry its exploration noise                          (0,0)
@@ -86,6 +91,20 @@ void write_recording(const mppi::sim::Recording& rec, const std::string& path) {
   w.close();
 }
 
+// A recording of the learned model made elsewhere (an mppi-sim log): the commands are the
+// ones the car received (applied_*, after the simulator's actuator slew limits) when logged.
+mppi::sim::Recording read_model_log(const std::string& path) {
+  mppi::sim::Recording rec = mppi::sim::RecordingReader::read(path);
+  if (rec.has_column("applied_steer") && rec.has_column("applied_throttle")) {
+    const std::vector<double> steer = rec.column("applied_steer"), throttle = rec.column("applied_throttle");
+    for (std::size_t c = 0; c < rec.columns.size(); ++c) {
+      if (rec.columns[c] == "steer") rec.data[c] = steer;
+      if (rec.columns[c] == "throttle") rec.data[c] = throttle;
+    }
+  }
+  return rec;
+}
+
 // Markdown table: channel x lead, before / after / change.
 std::string error_table(const mppi::sysid::PredictionError& before, const mppi::sysid::PredictionError& after) {
   std::string s = "| channel | lead [s] | NRMSE before | NRMSE after | change |\n|---|---|---|---|---|\n";
@@ -117,6 +136,7 @@ int mppi_fit_calibrate(int argc, char** argv) {
   std::vector<std::string> names = {"max_steer_rad", "stall_torque_Nm", "no_load_speed_mps", "brake_torque_ratio",
                                     "rolling_resistance", "aero_drag_kgpm", "tyre.B", "tyre.C", "tyre.D",
                                     "tyre.E", "tyre.Sv"};
+  std::vector<std::string> train_logs, heldout_logs;
   ManoeuvreOptions train_opt, held_opt;
   train_opt.duration_s = held_opt.duration_s = 100;
   CalibrationOptions cal;
@@ -148,6 +168,10 @@ int mppi_fit_calibrate(int argc, char** argv) {
         const double s = number(a, value());
         if (!(s >= 0 && s == std::floor(s))) throw Error("--seed expects a non-negative integer");
         train_opt.seed = static_cast<std::uint64_t>(s);
+      } else if (a == "--train-log") {
+        train_logs.push_back(value());
+      } else if (a == "--heldout-log") {
+        heldout_logs.push_back(value());
       } else if (a == "--dither") {
         const std::vector<std::string> parts = split_list(value());
         if (parts.size() != 2) throw Error("--dither expects STEER_STD,THROTTLE_STD");
@@ -185,8 +209,12 @@ int mppi_fit_calibrate(int argc, char** argv) {
       for (int i = 0; i < AutoRallyNetwork::kNx; ++i) x[static_cast<std::size_t>(i)] += dx[i] * dt;
     };
     const std::vector<double> x0(AutoRallyNetwork::kNx, 0.0);
-    const sim::Recording train = roll_out_manoeuvres(net_step, x0, train_opt);
+    std::vector<sim::Recording> train_pieces = {roll_out_manoeuvres(net_step, x0, train_opt)};
+    for (const std::string& f : train_logs) train_pieces.push_back(read_model_log(f));
+    const sim::Recording train = join_recordings(train_pieces);
     const sim::Recording held = roll_out_manoeuvres(net_step, x0, held_opt);
+    std::vector<sim::Recording> held_log_pieces;
+    for (const std::string& f : heldout_logs) held_log_pieces.push_back(read_model_log(f));
 
     VehicleModelSpec spec;
     if (params_file.empty())
@@ -200,8 +228,9 @@ int mppi_fit_calibrate(int argc, char** argv) {
 
     const std::vector<double> train_scales = channel_scales(train, cal.error.channels);
     const std::vector<double> held_scales = channel_scales(held, cal.error.channels);
-    std::printf("calibrating %s (%zu parameters) to %s: %.0f s training, %.0f s held out\n", model.c_str(),
-                names.size(), net_path.c_str(), train_opt.duration_s, held_opt.duration_s);
+    std::printf("calibrating %s (%zu parameters) to %s: %.0f s training (%zu logs besides), %.0f s held out\n",
+                model.c_str(), names.size(), net_path.c_str(), train_opt.duration_s, train_logs.size(),
+                held_opt.duration_s);
     const CalibrationResult fit = calibrate(spec, train, train_scales, cal);
     const PredictionError before = prediction_error(spec, spec.nominal, held, held_scales, cal.error);
     const PredictionError after = prediction_error(spec, fit.values, held, held_scales, cal.error);
@@ -252,7 +281,21 @@ int mppi_fit_calibrate(int argc, char** argv) {
                   train_after.mean_nrmse, before.mean_nrmse, after.mean_nrmse,
                   100 * (after.mean_nrmse - before.mean_nrmse) / before.mean_nrmse, after.rollouts);
     summary += line;
-    const std::string table = error_table(before, after);
+    std::string table = error_table(before, after);
+    if (!held_log_pieces.empty()) {
+      const sim::Recording held_logs = join_recordings(held_log_pieces);
+      const std::vector<double> log_scales = channel_scales(held_logs, cal.error.channels);
+      const PredictionError log_before = prediction_error(spec, spec.nominal, held_logs, log_scales, cal.error);
+      const PredictionError log_after = prediction_error(spec, fit.values, held_logs, log_scales, cal.error);
+      const std::string log_table = error_table(log_before, log_after);
+      std::snprintf(line, sizeof line, "held-out logs 1-s mean NRMSE: %.3f -> %.3f (%+.0f %%), %d rollouts\n",
+                    log_before.mean_nrmse, log_after.mean_nrmse,
+                    100 * (log_after.mean_nrmse - log_before.mean_nrmse) / log_before.mean_nrmse,
+                    log_after.rollouts);
+      summary += line;
+      std::ofstream(out_dir + "/fit_logs.md") << log_table;
+      table += "\nheld-out logs:\n" + log_table;
+    }
     std::ofstream(out_dir + "/summary.txt") << summary;
     std::ofstream(out_dir + "/fit.md") << table;
     std::fputs(summary.c_str(), stdout);

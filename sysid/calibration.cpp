@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include <Eigen/Dense>
 
@@ -23,7 +24,15 @@ struct RolloutPlan {
   const std::vector<double>* t = nullptr;
   const std::vector<double>* steer = nullptr;
   const std::vector<double>* throttle = nullptr;
+  double dt_s = 0;                  // the recording's sample interval (median step)
 };
+
+double sample_interval_s(const std::vector<double>& t) {
+  std::vector<double> steps(t.size() - 1);
+  for (std::size_t i = 1; i < t.size(); ++i) steps[i - 1] = t[i] - t[i - 1];
+  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
+  return steps[steps.size() / 2];
+}
 
 RolloutPlan make_plan(const VehicleModelSpec& spec, const sim::Recording& rec, const PredictionErrorOptions& o) {
   std::string why;
@@ -42,11 +51,20 @@ RolloutPlan make_plan(const VehicleModelSpec& spec, const sim::Recording& rec, c
   }
   const std::size_t n = rec.rows();
   if (n < 3) throw Error("prediction error: the recording has fewer than 3 rows");
-  const double dt = ((*p.t)[n - 1] - (*p.t)[0]) / static_cast<double>(n - 1);
-  p.steps = std::max(1, static_cast<int>(std::lround(o.horizon_s / dt)));
-  const std::size_t stride = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(o.stride_s / dt)));
-  for (std::size_t s = 0; s + static_cast<std::size_t>(p.steps) < n; s += stride) p.starts.push_back(s);
-  if (p.starts.empty()) throw Error("prediction error: the recording is shorter than one horizon");
+  p.dt_s = sample_interval_s(*p.t);
+  p.steps = std::max(1, static_cast<int>(std::lround(o.horizon_s / p.dt_s)));
+  const std::size_t stride = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(o.stride_s / p.dt_s)));
+  // A rollout never spans a gap (a dropout, or the seam between joined recordings): its
+  // window, and the sample before it (the actuators' last command), must last no longer than
+  // their samples at the recording's interval.
+  const auto steps = static_cast<std::size_t>(p.steps);
+  const auto& t = *p.t;
+  if (steps >= n) throw Error("prediction error: the recording is shorter than one horizon");
+  for (std::size_t s = 0; s + steps < n; s += stride) {
+    const bool after_gap = s > 0 && t[s] - t[s - 1] > 1.5 * p.dt_s;
+    if (!after_gap && t[s + steps] - t[s] <= (static_cast<double>(steps) + 0.5) * p.dt_s) p.starts.push_back(s);
+  }
+  if (p.starts.empty()) throw Error("prediction error: the recording has no gap-free stretch of one horizon");
   return p;
 }
 
@@ -143,7 +161,7 @@ PredictionError prediction_error(const VehicleModelSpec& spec, const std::vector
   e.scales = scales;
   e.horizons_s = o.report_horizons_s;
   e.rollouts = static_cast<int>(p.starts.size());
-  const double dt = (*p.t)[1] - (*p.t)[0];
+  const double dt = p.dt_s;
   std::vector<int> lead_of;
   for (double h : o.report_horizons_s) lead_of.push_back(std::clamp(static_cast<int>(std::lround(h / dt)), 1, p.steps));
   e.nrmse_at.assign(nc, std::vector<double>(lead_of.size(), 0.0));
@@ -172,6 +190,33 @@ PredictionError prediction_error(const VehicleModelSpec& spec, const std::vector
     e.mean_nrmse += e.nrmse[c] / static_cast<double>(nc);
   }
   return e;
+}
+
+sim::Recording join_recordings(const std::vector<sim::Recording>& pieces, double gap_s) {
+  if (pieces.empty()) throw Error("join recordings: no recordings");
+  if (!(gap_s > 1.0 && std::isfinite(gap_s))) throw Error("join recordings: the gap must be > 1 s");
+  for (std::size_t k = 0; k < pieces.size(); ++k)
+    if (pieces[k].rows() == 0) throw Error("join recordings: recording " + std::to_string(k + 1) + " is empty");
+  sim::Recording out;
+  out.metadata = pieces.front().metadata;
+  for (const std::string& c : pieces.front().columns)
+    if (std::all_of(pieces.begin(), pieces.end(), [&](const sim::Recording& r) { return r.has_column(c); }))
+      out.columns.push_back(c);
+  out.data.resize(out.columns.size());
+  double shift_s = 0;
+  for (const sim::Recording& r : pieces) {
+    const std::vector<double>& t = r.column("t");
+    if (!out.data.empty() && out.rows() > 0) shift_s = out.column("t").back() + gap_s - t.front();
+    for (std::size_t c = 0; c < out.columns.size(); ++c) {
+      const std::vector<double>& src = r.column(out.columns[c]);
+      std::vector<double>& dst = out.data[c];
+      const std::size_t first = dst.size();
+      dst.insert(dst.end(), src.begin(), src.end());
+      if (out.columns[c] == "t")
+        for (std::size_t i = first; i < dst.size(); ++i) dst[i] += shift_s;
+    }
+  }
+  return out;
 }
 
 CalibrationResult calibrate(const VehicleModelSpec& spec, const sim::Recording& rec, const std::vector<double>& scales,

@@ -40,11 +40,20 @@ std::vector<double> channel_scales(const sim::Recording& rec, const std::vector<
 
 // Prediction error of the model with `values` on `rec`, normalised by `scales` (one per
 // channel). Throws mppi::Error for a channel the model does not measure, invalid options, or
-// a recording shorter than one horizon. A rollout that goes non-finite counts with residual
+// a recording with no gap-free stretch of one horizon. Rollouts start every stride_s
+// except where their window would span a gap in t (longer than the median sample interval
+// allows). A rollout that goes non-finite counts with residual
 // 10 (normalised) from then on.
 PredictionError prediction_error(const VehicleModelSpec& spec, const std::vector<double>& values,
                                  const sim::Recording& rec, const std::vector<double>& scales,
                                  const PredictionErrorOptions& options = {});
+
+// Recordings joined end to end into one, for a fit or a judgement over several: the columns
+// every piece has (in the first one's order), each later piece shifted in time to start
+// `gap_s` after the previous one ends. prediction_error() starts no rollout across a gap, and
+// a gap longer than 1 s keeps the actuator priming (1 s of command history) from reaching
+// across it. Throws mppi::Error for no pieces, an empty piece, or gap_s <= 1.
+sim::Recording join_recordings(const std::vector<sim::Recording>& pieces, double gap_s = 10.0);
 
 struct CalibrationOptions {
   PredictionErrorOptions error;
