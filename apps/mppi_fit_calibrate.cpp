@@ -18,6 +18,7 @@
 #include "dynamics/model_registry.hpp"
 #include "dynamics/vehicle_params.hpp"
 #include "mppi/error.hpp"
+#include "mppi/vehicle_state.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"
 #include "sysid/calibration.hpp"
@@ -29,12 +30,13 @@ namespace {
 const char* kCalibrateUsage = R"(usage: mppi-fit calibrate [options]
   --network FILE       learned dynamics used as the recording of the car
                        (default data/autorally/models/autorally_nnet_09_12_2018.npz)
-  --model NAME         single-track | double-track                          (single-track)
+  --model NAME         single-track | double-track | full-vehicle         (single-track)
   --params FILE        starting (and "before") parameters
                        (default data/config/autorally_<model>_uncalibrated.yaml)
   --estimate A,B,...   parameters to fit (default: max_steer_rad, stall_torque_Nm,
                        no_load_speed_mps, brake_torque_ratio, rolling_resistance,
-                       aero_drag_kgpm, tyre.B, tyre.C, tyre.D, tyre.E, tyre.Sv); also
+                       aero_drag_kgpm (the full vehicle: drag_coefficient), tyre.B, tyre.C,
+                       tyre.D, tyre.E, tyre.Sv); also
                        rear_tyre_B_scale, rear_tyre_C_scale, rear_tyre_D_scale (per-axle
                        tyres) and the single-track's actuator terms steer_lag_s,
                        throttle_lag_s, steer_cubic, steer_offset (then calibrated.yaml is a
@@ -53,7 +55,8 @@ const char* kCalibrateUsage = R"(usage: mppi-fit calibrate [options]
   --horizon S          open-loop prediction horizon of the objective        (1)
   --stride S           a rollout starts every S seconds                     (0.5)
   --iterations N       Levenberg-Marquardt iterations at most               (40)
-  --out DIR            calibrated.yaml, fit.md, summary.txt, train.csv, heldout.csv
+  --out DIR            calibrated.yaml, fit.md (errors per channel and lead, steering
+                       step response), summary.txt, train.csv, heldout.csv
                                                                             (out/calibrate)
 )";
 
@@ -127,6 +130,42 @@ std::string error_table(const mppi::sysid::PredictionError& before, const mppi::
   return s;
 }
 
+// Yaw rate after a steering step (0 -> 0.3 at 6 m/s, throttle 0.3) of the learned model and of
+// the plant before and after the fit: the learned model holds no actuator state, so how it
+// answers a step shows what a plant needs to follow it (docs/CALIBRATION.md).
+std::string step_response_table(const mppi::sysid::RolloutStep& net_step, const mppi::sysid::VehicleModelSpec& spec,
+                                const std::vector<double>& fitted) {
+  const double speed = 6.0, steer = 0.3, throttle = 0.3, dt = 0.02;
+  const std::vector<double> leads = {0.02, 0.04, 0.1, 0.2, 0.3, 0.5, 1.0};
+  std::vector<double> x(mppi::AutoRallyNetwork::kNx, 0.0), net;
+  x[mppi::state::kVx] = speed;
+  double t = 0;
+  for (double lead : leads) {
+    for (; t < lead - 0.5 * dt; t += dt) {
+      const double u[2] = {steer, throttle};
+      net_step(x, u, dt);
+    }
+    net.push_back(x[mppi::state::kYawRate]);
+  }
+  const std::vector<double> before = mppi::sysid::steering_step_yaw_rate(spec, spec.nominal, speed, steer, throttle, leads, dt);
+  const std::vector<double> after = mppi::sysid::steering_step_yaw_rate(spec, fitted, speed, steer, throttle, leads, dt);
+  std::string s = "steering step 0 -> 0.3 at 6 m/s (throttle 0.3), yaw rate [rad/s]:\n\n"
+                  "| after [s] | learned model | plant before | plant after |\n|---|---|---|---|\n";
+  char line[160];
+  for (std::size_t i = 0; i < leads.size(); ++i) {
+    std::snprintf(line, sizeof line, "| %.2f | %.3f | %.3f | %.3f |\n", leads[i], net[i], before[i], after[i]);
+    s += line;
+  }
+  return s;
+}
+
+std::string file_stem(const std::string& model) {
+  std::string stem = model;
+  for (char& c : stem)
+    if (c == '-') c = '_';
+  return stem;  // single-track -> single_track
+}
+
 }  // namespace
 
 int mppi_fit_calibrate(int argc, char** argv) {
@@ -154,8 +193,9 @@ int mppi_fit_calibrate(int argc, char** argv) {
         network_file = value();
       } else if (a == "--model") {
         model = value();
-        if (model != models::SingleTrackModel::kName && model != models::DoubleTrackModel::kName)
-          throw Error("--model expects single-track or double-track, got '" + model + "'");
+        if (model != models::SingleTrackModel::kName && model != models::DoubleTrackModel::kName &&
+            model != models::FullVehicleModel::kName)
+          throw Error("--model expects single-track, double-track or full-vehicle, got '" + model + "'");
       } else if (a == "--params") {
         params_file = value();
       } else if (a == "--estimate") {
@@ -217,14 +257,17 @@ int mppi_fit_calibrate(int argc, char** argv) {
     for (const std::string& f : heldout_logs) held_log_pieces.push_back(read_model_log(f));
 
     VehicleModelSpec spec;
-    if (params_file.empty())
-      params_file = sim::data_file(model == models::SingleTrackModel::kName
-                                       ? "config/autorally_single_track_uncalibrated.yaml"
-                                       : "config/autorally_double_track_uncalibrated.yaml");
-    if (model == models::SingleTrackModel::kName)
+    if (params_file.empty()) params_file = sim::data_file("config/autorally_" + file_stem(model) + "_uncalibrated.yaml");
+    if (model == models::SingleTrackModel::kName) {
       spec = single_track_spec(load_single_track_params(params_file), names);
-    else
+    } else if (model == models::DoubleTrackModel::kName) {
       spec = double_track_spec(load_double_track_params(params_file), names);
+    } else {
+      // The full vehicle's drag is drag_coefficient (x air density x frontal area / 2).
+      for (std::string& n : names)
+        if (n == "aero_drag_kgpm") n = "drag_coefficient";
+      spec = full_vehicle_spec(load_full_vehicle_params(params_file), names);
+    }
 
     const std::vector<double> train_scales = channel_scales(train, cal.error.channels);
     const std::vector<double> held_scales = channel_scales(held, cal.error.channels);
@@ -296,6 +339,7 @@ int mppi_fit_calibrate(int argc, char** argv) {
       std::ofstream(out_dir + "/fit_logs.md") << log_table;
       table += "\nheld-out logs:\n" + log_table;
     }
+    table += "\n" + step_response_table(net_step, spec, fit.values);
     std::ofstream(out_dir + "/summary.txt") << summary;
     std::ofstream(out_dir + "/fit.md") << table;
     std::fputs(summary.c_str(), stdout);

@@ -115,7 +115,7 @@ int run_estimate(EstimateArgs& args) {
       if (have_truth) truth_spec = double_track_spec(load_double_track_params(truth_file), estimate_names);
     } else {
       const FullVehicleParams base = load_full_vehicle_params(
-          params_file.empty() ? sim::data_file("config/autorally_full_vehicle.yaml") : params_file);
+          params_file.empty() ? sim::data_file("config/autorally_full_vehicle_uncalibrated.yaml") : params_file);
       if (estimate_names.empty())
         estimate_names = {"mass_kg", "yaw_inertia_kgm2", "rear_wheel_inertia_kgm2", "cg_height_m",
                           "cg_to_front_axle_m", "tyre.B", "tyre.C", "tyre.D",
@@ -389,7 +389,7 @@ void add_estimate_command(CLI::App& fit, FitCommands& commands) {
   mppi::cli::add_model_option(*cmd, "--model", args->model, "model", estimable_models());
   cmd->add_option("--params", args->params_file,
                   "base parameters (YAML of that model, keys in --list-params; default "
-                  "data/config/autorally_<model>.yaml)")
+                  "data/config/autorally_<model>.yaml; the full vehicle: autorally_full_vehicle_uncalibrated.yaml, the paper's values)")
       ->type_name("FILE");
   cmd->add_option("--estimate", args->estimate_text, "parameters to estimate (YAML keys, tyre.B etc.; default: a "
                                                      "model's usual set)")

@@ -35,7 +35,7 @@ int run_protocol(ProtocolArgs& args) {
     *s *= args.noise_scale;
   try {
     const mppi::FullVehicleParams params = mppi::load_full_vehicle_params(
-        args.params_path.empty() ? mppi::sim::data_file("config/autorally_full_vehicle.yaml") : args.params_path);
+        args.params_path.empty() ? mppi::sim::data_file("config/autorally_full_vehicle_uncalibrated.yaml") : args.params_path);
     const auto run = mppi::sysid::run_protocol(params, options);
     mppi::sysid::write_protocol(run, params, args.out);
     mppi::sysid::plot_protocol(run, args.out + "/protocol.png");
@@ -65,7 +65,7 @@ void add_protocol_command(CLI::App& fit, FitCommands& commands) {
       mppi::cli::model_parameter_help(mppi::models::FullVehicleModel::kName));
   cmd->add_option("--params", args->params_path,
                   "full-vehicle parameters of the plant (YAML, keys below; default "
-                  "data/config/autorally_full_vehicle.yaml)")
+                  "data/config/autorally_full_vehicle_uncalibrated.yaml: the paper's values)")
       ->type_name("FILE");
   mppi::cli::add_out_option(*cmd, args->out, "output folder");
   mppi::cli::add_seed_option(*cmd, o.seed, "sensor-noise seed");

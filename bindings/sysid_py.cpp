@@ -69,7 +69,7 @@ mppi::sim::Recording load(const std::string& spec) {
 const char* default_params_file(const std::string& model) {
   if (model == mppi::models::SingleTrackModel::kName) return "config/autorally_single_track.yaml";
   if (model == mppi::models::DoubleTrackModel::kName) return "config/autorally_double_track.yaml";
-  if (model == mppi::models::FullVehicleModel::kName) return "config/autorally_full_vehicle.yaml";
+  if (model == mppi::models::FullVehicleModel::kName) return "config/autorally_full_vehicle_uncalibrated.yaml";
   throw mppi::Error("model: expects single-track, double-track or full-vehicle, got '" + model + "'");
 }
 
@@ -224,7 +224,7 @@ py::dict protocol(const std::string& params_file, const std::map<std::string, do
                   double validation_duration_s, double sample_rate_hz, std::uint64_t seed, double noise_scale,
                   const std::string& out_dir) {
   using namespace mppi::sysid;
-  const std::string base_file = params_file.empty() ? mppi::sim::data_file("config/autorally_full_vehicle.yaml") : params_file;
+  const std::string base_file = params_file.empty() ? mppi::sim::data_file("config/autorally_full_vehicle_uncalibrated.yaml") : params_file;
   mppi::FullVehicleParams truth = mppi::load_full_vehicle_params(base_file);
   if (!overrides.empty()) {
     // Set the values through the estimation spec's YAML writer and read them back with the loader.
@@ -428,7 +428,7 @@ void register_sysid(py::module_& m) {
         py::arg("validation_duration_s") = 13.0, py::arg("sample_rate_hz") = 50.0, py::arg("seed") = 1,
         py::arg("noise_scale") = 1.0, py::arg("out_dir") = "",
         "the paper's estimation protocol driven with the full-vehicle plant (params_file, default "
-        "data/config/autorally_full_vehicle.yaml, with overrides {yaml key: value}); returns {'training', "
+        "data/config/autorally_full_vehicle_uncalibrated.yaml, the paper's values, with overrides {yaml key: value}); returns {'training', "
         "'validation', 'truth'} recording dicts; out_dir: also writes train.csv, validation.csv, truth.csv, "
         "truth.yaml there (as mppi-fit protocol). Releases the GIL.");
 

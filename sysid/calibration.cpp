@@ -219,6 +219,38 @@ sim::Recording join_recordings(const std::vector<sim::Recording>& pieces, double
   return out;
 }
 
+std::vector<double> steering_step_yaw_rate(const VehicleModelSpec& spec, const std::vector<double>& values,
+                                           double speed_mps, double steer, double throttle,
+                                           const std::vector<double>& leads_s, double dt_s) {
+  if (!(dt_s > 0) || leads_s.empty()) throw Error("steering step: dt_s > 0 and at least one lead are needed");
+  // 1 s of straight driving, then the step: a recording to start (and prime) the plant from.
+  const int before = static_cast<int>(std::lround(1.0 / dt_s));
+  sim::Recording rec;
+  rec.columns = {"t", "x", "y", "yaw", "vx", "vy", "yaw_rate", "steer", "throttle"};
+  rec.data.assign(rec.columns.size(), {});
+  for (int i = 0; i <= before; ++i) {
+    const double row[9] = {i * dt_s, 0, 0, 0, speed_mps, 0, 0, i < before ? 0.0 : steer, throttle};
+    for (std::size_t c = 0; c < 9; ++c) rec.data[c].push_back(row[c]);
+  }
+  std::vector<double> x(static_cast<std::size_t>(spec.nx));
+  spec.init_state(rec, static_cast<std::size_t>(before), x.data());
+  if (spec.prime) spec.prime(values, rec, static_cast<std::size_t>(before), x.data());
+  const auto m = std::find_if(spec.measurable.begin(), spec.measurable.end(),
+                              [](const auto& c) { return c.first == "yaw_rate"; });
+  if (m == spec.measurable.end()) throw Error("steering step: the " + spec.kind + " model has no yaw rate");
+  const auto yaw_rate = static_cast<std::size_t>(m->second);
+  std::vector<double> out;
+  double t = 0;
+  for (double lead : leads_s) {
+    for (; t < lead - 0.5 * dt_s; t += dt_s) {
+      const double u[2] = {steer, throttle};
+      spec.step(values, x.data(), u, dt_s);
+    }
+    out.push_back(x[yaw_rate]);
+  }
+  return out;
+}
+
 CalibrationResult calibrate(const VehicleModelSpec& spec, const sim::Recording& rec, const std::vector<double>& scales,
                             const CalibrationOptions& o, std::vector<double> initial) {
   std::string why;

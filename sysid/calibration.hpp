@@ -55,6 +55,13 @@ PredictionError prediction_error(const VehicleModelSpec& spec, const std::vector
 // across it. Throws mppi::Error for no pieces, an empty piece, or gap_s <= 1.
 sim::Recording join_recordings(const std::vector<sim::Recording>& pieces, double gap_s = 10.0);
 
+// Yaw rate of the plant `spec` with `values` at each of `leads_s` after a steering step from
+// straight driving at speed_mps, the throttle held (its actuator states, if any, primed with
+// 1 s of straight driving): how fast and how far the car answers a steering command.
+std::vector<double> steering_step_yaw_rate(const VehicleModelSpec& spec, const std::vector<double>& values,
+                                           double speed_mps, double steer, double throttle,
+                                           const std::vector<double>& leads_s, double dt_s = 0.02);
+
 struct CalibrationOptions {
   PredictionErrorOptions error;
   int max_iterations = 40;

@@ -278,7 +278,7 @@ TEST_CASE("Double-track batched float step<64> equals Euler in double", "[physic
 
 TEST_CASE("Double-track parameters: YAML file, round trip, errors", "[physics][double_track]") {
   const DoubleTrackParams file =
-      mppi::load_double_track_params(mppi::test::data_path("config/autorally_double_track.yaml"));
+      mppi::load_double_track_params(mppi::test::data_path("config/autorally_double_track_uncalibrated.yaml"));
   const DoubleTrackParams def;
   CHECK(file.base.mass_kg == def.base.mass_kg);
   CHECK(file.front_track_m == 0.395);

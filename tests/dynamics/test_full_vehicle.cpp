@@ -327,7 +327,7 @@ TEST_CASE("Full vehicle at the controller's 0.02 s stays finite and bounded", "[
 
 TEST_CASE("Full-vehicle parameters: YAML file, round trip, errors", "[physics][full_vehicle]") {
   const FullVehicleParams file =
-      mppi::load_full_vehicle_params(mppi::test::data_path("config/autorally_full_vehicle.yaml"));
+      mppi::load_full_vehicle_params(mppi::test::data_path("config/autorally_full_vehicle_uncalibrated.yaml"));
   const FullVehicleParams def;
   CHECK(file.base.mass_kg == 21.88);
   CHECK(file.front_spring_Npm == 2000.0);
