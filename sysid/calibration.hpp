@@ -58,6 +58,7 @@ sim::Recording join_recordings(const std::vector<sim::Recording>& pieces, double
 // Yaw rate of the plant `spec` with `values` at each of `leads_s` after a steering step from
 // straight driving at speed_mps, the throttle held (its actuator states, if any, primed with
 // 1 s of straight driving): how fast and how far the car answers a steering command.
+// leads_s in increasing order.
 std::vector<double> steering_step_yaw_rate(const VehicleModelSpec& spec, const std::vector<double>& values,
                                            double speed_mps, double steer, double throttle,
                                            const std::vector<double>& leads_s, double dt_s = 0.02);
