@@ -47,7 +47,9 @@ const char* kCalibrateUsage = R"(usage: mppi-fit calibrate [options]
   --train-log FILE     also fit to this recording of the learned model (e.g. an mppi-sim
                        log.csv with --plant autorally-nn: closed-loop driving at the operating
                        point); repeatable. Logs with applied_steer / applied_throttle columns
-                       are read with those as the commands (what the car received)
+                       are read with those as the commands (what the car received);
+                       a run whose car was put back (a crash or stall) should be cut
+                       there first: the log does not mark the jump
   --heldout-log FILE   also judge on this recording (a second table, fit_logs.md); repeatable
   --dither S,T         white noise (std) added to every steering / throttle
                        command of both sequences, as MPPI's applied commands
@@ -94,20 +96,6 @@ void write_recording(const mppi::sim::Recording& rec, const std::string& path) {
   w.close();
 }
 
-// A recording of the learned model made elsewhere (an mppi-sim log): the commands are the
-// ones the car received (applied_*, after the simulator's actuator slew limits) when logged.
-mppi::sim::Recording read_model_log(const std::string& path) {
-  mppi::sim::Recording rec = mppi::sim::RecordingReader::read(path);
-  if (rec.has_column("applied_steer") && rec.has_column("applied_throttle")) {
-    const std::vector<double> steer = rec.column("applied_steer"), throttle = rec.column("applied_throttle");
-    for (std::size_t c = 0; c < rec.columns.size(); ++c) {
-      if (rec.columns[c] == "steer") rec.data[c] = steer;
-      if (rec.columns[c] == "throttle") rec.data[c] = throttle;
-    }
-  }
-  return rec;
-}
-
 // Markdown table: channel x lead, before / after / change.
 std::string error_table(const mppi::sysid::PredictionError& before, const mppi::sysid::PredictionError& after) {
   std::string s = "| channel | lead [s] | NRMSE before | NRMSE after | change |\n|---|---|---|---|---|\n";
@@ -137,16 +125,10 @@ std::string step_response_table(const mppi::sysid::RolloutStep& net_step, const 
                                 const std::vector<double>& fitted) {
   const double speed = 6.0, steer = 0.3, throttle = 0.3, dt = 0.02;
   const std::vector<double> leads = {0.02, 0.04, 0.1, 0.2, 0.3, 0.5, 1.0};
-  std::vector<double> x(mppi::AutoRallyNetwork::kNx, 0.0), net;
+  std::vector<double> x(mppi::AutoRallyNetwork::kNx, 0.0);
   x[mppi::state::kVx] = speed;
-  double t = 0;
-  for (double lead : leads) {
-    for (; t < lead - 0.5 * dt; t += dt) {
-      const double u[2] = {steer, throttle};
-      net_step(x, u, dt);
-    }
-    net.push_back(x[mppi::state::kYawRate]);
-  }
+  const double u[2] = {steer, throttle};
+  const std::vector<double> net = mppi::sysid::step_response(net_step, x, u, mppi::state::kYawRate, leads, dt);
   const std::vector<double> before = mppi::sysid::steering_step_yaw_rate(spec, spec.nominal, speed, steer, throttle, leads, dt);
   const std::vector<double> after = mppi::sysid::steering_step_yaw_rate(spec, fitted, speed, steer, throttle, leads, dt);
   std::string s = "steering step 0 -> 0.3 at 6 m/s (throttle 0.3), yaw rate [rad/s]:\n\n"
@@ -159,11 +141,10 @@ std::string step_response_table(const mppi::sysid::RolloutStep& net_step, const 
   return s;
 }
 
-std::string file_stem(const std::string& model) {
-  std::string stem = model;
-  for (char& c : stem)
-    if (c == '-') c = '_';
-  return stem;  // single-track -> single_track
+// The model's shipped data file with "_uncalibrated" before ".yaml": the values before calibration.
+std::string uncalibrated_file(std::string default_file) {
+  default_file.insert(default_file.rfind(".yaml"), "_uncalibrated");
+  return mppi::sim::data_file(default_file);
 }
 
 }  // namespace
@@ -250,19 +231,21 @@ int mppi_fit_calibrate(int argc, char** argv) {
     };
     const std::vector<double> x0(AutoRallyNetwork::kNx, 0.0);
     std::vector<sim::Recording> train_pieces = {roll_out_manoeuvres(net_step, x0, train_opt)};
-    for (const std::string& f : train_logs) train_pieces.push_back(read_model_log(f));
+    for (const std::string& f : train_logs) train_pieces.push_back(read_learned_model_log(f));
     const sim::Recording train = join_recordings(train_pieces);
     const sim::Recording held = roll_out_manoeuvres(net_step, x0, held_opt);
     std::vector<sim::Recording> held_log_pieces;
-    for (const std::string& f : heldout_logs) held_log_pieces.push_back(read_model_log(f));
+    for (const std::string& f : heldout_logs) held_log_pieces.push_back(read_learned_model_log(f));
 
     VehicleModelSpec spec;
-    if (params_file.empty()) params_file = sim::data_file("config/autorally_" + file_stem(model) + "_uncalibrated.yaml");
     if (model == models::SingleTrackModel::kName) {
+      if (params_file.empty()) params_file = uncalibrated_file(models::SingleTrackModel::kDefaultFile);
       spec = single_track_spec(load_single_track_params(params_file), names);
     } else if (model == models::DoubleTrackModel::kName) {
+      if (params_file.empty()) params_file = uncalibrated_file(models::DoubleTrackModel::kDefaultFile);
       spec = double_track_spec(load_double_track_params(params_file), names);
     } else {
+      if (params_file.empty()) params_file = uncalibrated_file(models::FullVehicleModel::kDefaultFile);
       // The full vehicle's drag is drag_coefficient (x air density x frontal area / 2).
       for (std::string& n : names)
         if (n == "aero_drag_kgpm") n = "drag_coefficient";

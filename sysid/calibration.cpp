@@ -195,26 +195,66 @@ PredictionError prediction_error(const VehicleModelSpec& spec, const std::vector
 sim::Recording join_recordings(const std::vector<sim::Recording>& pieces, double gap_s) {
   if (pieces.empty()) throw Error("join recordings: no recordings");
   if (!(gap_s > 1.0 && std::isfinite(gap_s))) throw Error("join recordings: the gap must be > 1 s");
-  for (std::size_t k = 0; k < pieces.size(); ++k)
-    if (pieces[k].rows() == 0) throw Error("join recordings: recording " + std::to_string(k + 1) + " is empty");
+  std::vector<double> interval_s;
+  for (std::size_t k = 0; k < pieces.size(); ++k) {
+    if (pieces[k].rows() < 2)
+      throw Error("join recordings: recording " + std::to_string(k + 1) + " has fewer than 2 rows");
+    interval_s.push_back(sample_interval_s(pieces[k].column("t")));
+    if (std::abs(interval_s[k] - interval_s[0]) > 0.01 * interval_s[0])
+      throw Error("join recordings: recording " + std::to_string(k + 1) + " is sampled every " +
+                  std::to_string(interval_s[k]) + " s, recording 1 every " + std::to_string(interval_s[0]) +
+                  " s (resample it first)");
+  }
   sim::Recording out;
   out.metadata = pieces.front().metadata;
   for (const std::string& c : pieces.front().columns)
     if (std::all_of(pieces.begin(), pieces.end(), [&](const sim::Recording& r) { return r.has_column(c); }))
       out.columns.push_back(c);
   out.data.resize(out.columns.size());
-  double shift_s = 0;
+  const std::size_t t_col = static_cast<std::size_t>(std::find(out.columns.begin(), out.columns.end(), "t") -
+                                                     out.columns.begin());
   for (const sim::Recording& r : pieces) {
-    const std::vector<double>& t = r.column("t");
-    if (!out.data.empty() && out.rows() > 0) shift_s = out.column("t").back() + gap_s - t.front();
+    const double shift_s = out.rows() > 0 ? out.data[t_col].back() + gap_s - r.column("t").front() : 0.0;
     for (std::size_t c = 0; c < out.columns.size(); ++c) {
       const std::vector<double>& src = r.column(out.columns[c]);
       std::vector<double>& dst = out.data[c];
       const std::size_t first = dst.size();
       dst.insert(dst.end(), src.begin(), src.end());
-      if (out.columns[c] == "t")
+      if (c == t_col)
         for (std::size_t i = first; i < dst.size(); ++i) dst[i] += shift_s;
     }
+  }
+  return out;
+}
+
+sim::Recording read_learned_model_log(const std::string& path) {
+  sim::Recording rec = sim::RecordingReader::read(path);
+  if (rec.has_column("applied_steer") && rec.has_column("applied_throttle")) {
+    const std::vector<double> steer = rec.column("applied_steer"), throttle = rec.column("applied_throttle");
+    for (std::size_t c = 0; c < rec.columns.size(); ++c) {
+      if (rec.columns[c] == "steer") rec.data[c] = steer;
+      if (rec.columns[c] == "throttle") rec.data[c] = throttle;
+    }
+  }
+  for (const char* c : {"steer", "throttle", "vx", "vy", "yaw_rate"}) {
+    const std::vector<double>& v = rec.column(c);
+    for (std::size_t i = 0; i < v.size(); ++i)
+      if (!std::isfinite(v[i]))
+        throw Error(path + ": data row " + std::to_string(i + 1) + ": " + c +
+                    " is missing or not finite (a calibration rolls out through every row)");
+  }
+  return rec;
+}
+
+std::vector<double> step_response(const RolloutStep& step, std::vector<double> x, const double u[2],
+                                  std::size_t channel, const std::vector<double>& leads_s, double dt_s) {
+  if (!(dt_s > 0) || leads_s.empty() || channel >= x.size())
+    throw Error("step response: dt_s > 0, at least one lead and a channel of the state are needed");
+  std::vector<double> out;
+  double t = 0;
+  for (double lead : leads_s) {
+    for (; t < lead - 0.5 * dt_s; t += dt_s) step(x, u, dt_s);
+    out.push_back(x[channel]);
   }
   return out;
 }
@@ -222,7 +262,7 @@ sim::Recording join_recordings(const std::vector<sim::Recording>& pieces, double
 std::vector<double> steering_step_yaw_rate(const VehicleModelSpec& spec, const std::vector<double>& values,
                                            double speed_mps, double steer, double throttle,
                                            const std::vector<double>& leads_s, double dt_s) {
-  if (!(dt_s > 0) || leads_s.empty()) throw Error("steering step: dt_s > 0 and at least one lead are needed");
+  if (!(dt_s > 0)) throw Error("steering step: dt_s must be > 0");
   // 1 s of straight driving, then the step: a recording to start (and prime) the plant from.
   const int before = static_cast<int>(std::lround(1.0 / dt_s));
   sim::Recording rec;
@@ -238,17 +278,11 @@ std::vector<double> steering_step_yaw_rate(const VehicleModelSpec& spec, const s
   const auto m = std::find_if(spec.measurable.begin(), spec.measurable.end(),
                               [](const auto& c) { return c.first == "yaw_rate"; });
   if (m == spec.measurable.end()) throw Error("steering step: the " + spec.kind + " model has no yaw rate");
-  const auto yaw_rate = static_cast<std::size_t>(m->second);
-  std::vector<double> out;
-  double t = 0;
-  for (double lead : leads_s) {
-    for (; t < lead - 0.5 * dt_s; t += dt_s) {
-      const double u[2] = {steer, throttle};
-      spec.step(values, x.data(), u, dt_s);
-    }
-    out.push_back(x[yaw_rate]);
-  }
-  return out;
+  const RolloutStep plant = [&](std::vector<double>& s, const double u[2], double dt) {
+    spec.step(values, s.data(), u, dt);
+  };
+  const double u[2] = {steer, throttle};
+  return step_response(plant, std::move(x), u, static_cast<std::size_t>(m->second), leads_s, dt_s);
 }
 
 CalibrationResult calibrate(const VehicleModelSpec& spec, const sim::Recording& rec, const std::vector<double>& scales,

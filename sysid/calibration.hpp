@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sim/recording.hpp"
+#include "sysid/manoeuvre_rollout.hpp"
 #include "sysid/vehicle_estimation.hpp"
 
 namespace mppi::sysid {
@@ -52,13 +53,25 @@ PredictionError prediction_error(const VehicleModelSpec& spec, const std::vector
 // every piece has (in the first one's order), each later piece shifted in time to start
 // `gap_s` after the previous one ends. prediction_error() starts no rollout across a gap, and
 // a gap longer than 1 s keeps the actuator priming (1 s of command history) from reaching
-// across it. Throws mppi::Error for no pieces, an empty piece, or gap_s <= 1.
+// across it. Throws mppi::Error for no pieces, a piece with fewer than 2 rows, pieces
+// sampled at different intervals (more than 1 % apart), or gap_s <= 1.
 sim::Recording join_recordings(const std::vector<sim::Recording>& pieces, double gap_s = 10.0);
 
-// Yaw rate of the plant `spec` with `values` at each of `leads_s` after a steering step from
-// straight driving at speed_mps, the throttle held (its actuator states, if any, primed with
-// 1 s of straight driving): how fast and how far the car answers a steering command.
-// leads_s in increasing order.
+// A recording of a learned model made elsewhere (e.g. an mppi-sim log with the network as the
+// plant), to calibrate against: when it has applied_steer and applied_throttle columns (the
+// commands the car received, after the simulator's actuator limits) they replace steer and
+// throttle. Throws mppi::Error naming the file and the row for a missing or non-finite
+// command, v_x, v_y or yaw rate (a calibration cannot roll out through it).
+sim::Recording read_learned_model_log(const std::string& path);
+
+// Channel `channel` of the state after `step` is driven from `x` with the constant command `u`,
+// at each of `leads_s` (increasing).
+std::vector<double> step_response(const RolloutStep& step, std::vector<double> x, const double u[2],
+                                  std::size_t channel, const std::vector<double>& leads_s, double dt_s = 0.02);
+
+// Yaw rate of the plant `spec` with `values` at each of `leads_s` (increasing) after a steering
+// step from straight driving at speed_mps, the throttle held (its actuator states, if any,
+// primed with 1 s of straight driving): how fast and how far the car answers a steering command.
 std::vector<double> steering_step_yaw_rate(const VehicleModelSpec& spec, const std::vector<double>& values,
                                            double speed_mps, double steer, double throttle,
                                            const std::vector<double>& leads_s, double dt_s = 0.02);

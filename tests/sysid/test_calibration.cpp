@@ -4,8 +4,11 @@
 // network better than the uncalibrated one.
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <set>
 #include <tuple>
+
+#include <unistd.h>
 
 #include <catch2/catch.hpp>
 
@@ -373,6 +376,39 @@ TEST_CASE("joined recordings: no rollout spans a seam or starts on one, so a pla
 
   CHECK_THAT(error_of([] { join_recordings({}); }), Catch::Contains("no recordings"));
   CHECK_THAT(error_of([&] { join_recordings({a, b}, 0.5); }), Catch::Contains("gap"));
+  // A piece sampled at another rate would make the plan's steps wrong: refused by name.
+  sim::Recording slow = b;
+  for (double& v : slow.data[0]) v *= 2;  // every 0.04 s
+  CHECK_THAT(error_of([&] { join_recordings({a, slow}); }),
+             Catch::Contains("recording 2") && Catch::Contains("sampled every"));
+}
+
+TEST_CASE("a learned model's log is read with the commands the car received, and refused where it has holes",
+          "[sysid][calibration]") {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("mppi_calibration_log_" + std::to_string(::getpid()) + ".csv")).string();
+  auto write = [&](int hole_at_row) {
+    sim::RecordingWriter w(path, {"applied_steer", "applied_throttle"});
+    for (int i = 0; i < 10; ++i) {
+      const double steer = i == hole_at_row ? std::nan("") : 0.5;
+      w.write_row(std::vector<double>{0.02 * i, 0, 0, 0, 5, 0, 0, steer, 0.3, 0.1 * i, 0.2});
+    }
+    w.close();
+  };
+  write(-1);
+  const sim::Recording rec = read_learned_model_log(path);
+  CHECK(rec.column("steer")[4] == Approx(0.4));  // applied_steer, not the commanded 0.5
+  CHECK(rec.column("throttle")[4] == Approx(0.2));
+  write(6);  // the commanded steer is missing in data row 7; the applied one is there
+  CHECK(read_learned_model_log(path).column("steer")[6] == Approx(0.6));
+  {
+    sim::RecordingWriter w(path, {});
+    for (int i = 0; i < 10; ++i) w.write_row(std::vector<double>{0.02 * i, 0, 0, 0, i == 3 ? std::nan("") : 5.0, 0, 0, 0.1, 0.3});
+    w.close();
+  }
+  CHECK_THAT(error_of([&] { read_learned_model_log(path); }),
+             Catch::Contains(path) && Catch::Contains("data row 4") && Catch::Contains("vx"));
+  std::filesystem::remove(path);
 }
 
 TEST_CASE("steering step response: inertia scales the first answer, a servo lag delays it, neither the end",
