@@ -198,16 +198,22 @@ def test_protocol_releases_the_gil():
 def synth_log(tmp_path_factory):
     d = tmp_path_factory.mktemp("diag")
     path = str(d / "steer_delay.csv")
-    rec, ids = mppi.diagnose_synth_open_loop("steer_delay_s=0.08", seed=21, duration_s=40.0, out_path=path)
+    rec, ids = mppi.diagnose_synth_open_loop("steer_delay_s=0.08", seed=21, duration_s=12.0, out_path=path)
     assert ids == ["steer_delay"]
     return d, path, rec
 
 
+# The candidates: the steering's forms of dynamics, its gain and trim (and the joint of the two),
+# the drag and the throttle lag; the same list for the bindings and the program.
+DIAG_EFFECTS = ["steer_delay", "steer_lag", "steer_rate_limit", "steer_backlash", "steer_gain", "steer_offset",
+                "aero_drag", "throttle_lag"]
+
+
 def test_diagnose_names_hidden_effect_and_matches_cli(synth_log):
     d, path, rec = synth_log
-    assert len(rec["columns"]["t"]) == 40 * 50
+    assert len(rec["columns"]["t"]) == 12 * 50
     out_py = d / "py"
-    r = mppi.diagnose(path, out_dir=str(out_py), plots=False)
+    r = mppi.diagnose(path, effects=DIAG_EFFECTS, out_dir=str(out_py), plots=False)
     assert r["selected"] and r["selected"][0] == "steer_delay"
     delay = [p for p in r["final_params"] if p["name"] == "steer_delay_s"]
     assert delay and delay[0]["value"] == pytest.approx(0.08, abs=0.02)
@@ -217,8 +223,8 @@ def test_diagnose_names_hidden_effect_and_matches_cli(synth_log):
         assert json.load(f)["selected"] == r["selected"]
     need_fit()
     out_cli = d / "cli"
-    subprocess.run([FIT, "diagnose", "--log", path, "--out", str(out_cli), "--no-plots"], check=True,
-                   capture_output=True)
+    subprocess.run([FIT, "diagnose", "--log", path, "--effects", ",".join(DIAG_EFFECTS), "--out", str(out_cli),
+                    "--no-plots"], check=True, capture_output=True)
     with open(out_cli / "report.json") as f:
         cli = json.load(f)
     py = dict(r["report"])

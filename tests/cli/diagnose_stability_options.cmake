@@ -3,7 +3,8 @@
 # "of 3 resamples") and the delay is named; with 0 there is no stability selection (no resample
 # lines) and the delay chosen on all the data is named. The independent generator's sweep passes
 # both settings to its diagnoses: its runs.jsonl gives the named delay's inclusion frequency (a
-# share of 3 resamples) and -1 with 0 resamples. Needs BIN_DIR, WORK_DIR and SOURCE_DIR.
+# share of 3 resamples) and -1 with 0 resamples (the sweep's recordings: 10 s). Needs BIN_DIR,
+# WORK_DIR and SOURCE_DIR.
 set(out "${WORK_DIR}/diagnose_stability_options")
 file(REMOVE_RECURSE "${out}")
 file(MAKE_DIRECTORY "${out}")
@@ -33,7 +34,7 @@ foreach(n 3 0)
 endforeach()
 foreach(n 3 0)
   execute_process(COMMAND "${BIN_DIR}/mppi-fit" diagnose sweep --generator independent --effects throttle_delay
-                          --sizes large --seeds 1 --pairs 0 --clean 0 --duration 20 --stability-resamples ${n}
+                          --sizes large --seeds 1 --pairs 0 --clean 0 --duration 10 --stability-resamples ${n}
                           --min-inclusion 0.6 --out "${out}/sweep${n}"
                   RESULT_VARIABLE rc OUTPUT_VARIABLE log ERROR_VARIABLE err)
   if(NOT rc EQUAL 0)

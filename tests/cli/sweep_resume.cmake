@@ -1,10 +1,12 @@
 # mppi-fit diagnose sweep --resume: a sweep cut short goes on where it stopped. A first sweep of one
 # seed records its runs; the same sweep over two seeds with --resume keeps those records (same
-# lines, not rerun) and runs only the new seed's case. Needs BIN_DIR and WORK_DIR.
+# lines, not rerun) and runs only the new seed's case. Recordings of 10 s, diagnoses without
+# stability resamples: what is named does not matter here, which runs are run does. Needs BIN_DIR
+# and WORK_DIR.
 set(out "${WORK_DIR}/sweep_resume")
 file(REMOVE_RECURSE "${out}")
 set(common diagnose sweep --generator independent --effects throttle_delay --sizes large --pairs 0 --clean 1
-    --duration 15 --out "${out}")
+    --duration 10 --stability-resamples 0 --out "${out}")
 execute_process(COMMAND "${BIN_DIR}/mppi-fit" ${common} --seeds 1 RESULT_VARIABLE rc OUTPUT_VARIABLE first ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "first sweep failed (${rc}): ${err}")

@@ -28,13 +28,14 @@ inline diagnose::FitProblem training_problem(const diagnose::DiagData& d) {
   return p;
 }
 
-// A 40-s recording of the independent generator with the calibrated car and the hidden effects
-// `truth` (key=value,...), written to csv.
+// A recording of the independent generator (40 s unless told) with the calibrated car and the
+// hidden effects `truth` (key=value,...), written to csv.
 inline evidence::EvidenceResult independent_recording(const std::filesystem::path& csv, const std::string& truth,
                                                       std::uint64_t seed, const std::string& track,
-                                                      const std::string& direction, const std::string& driver) {
+                                                      const std::string& direction, const std::string& driver,
+                                                      double duration_s = 40.0) {
   evidence::EvidenceOptions o;
-  o.duration_s = 40;
+  o.duration_s = duration_s;
   o.seed = seed;
   o.track = track;
   o.direction = direction;

@@ -57,6 +57,32 @@ TEST_CASE("a steering play that the resamples split with a lag is named as the s
   CHECK(r.heldout_rmse_reduction > 0.3);
 }
 
+// The fast case of the one above: 30 s of the same driver and track (another seed), the steering's
+// forms of dynamics, its trim and the payload as candidates. The resamples choose the play in 3 of
+// 6, a delay and a lag in 1 each, and the payload in 3 (not named).
+TEST_CASE("a steering play that the resamples split with other forms on a short recording is named as the steering's dynamics",
+          "[diagnose]") {
+  const mppi::test::ScratchDir dir("mppi_actuator_dynamics_short_test");
+  DiagnoseOptions opt;
+  opt.selection.candidates = {"steer_delay", "steer_lag", "steer_rate_limit", "steer_backlash", "steer_offset", "payload"};
+  const DiagnoseResult r = mppi::test::diagnose_independent(
+      mppi::test::independent_recording(dir / "play.csv", "steer_backlash=0.1", 4, "ccrf", "ccw", "human", 30.0), opt);
+  const std::string named = mppi::test::joined(r.selection.selected);
+  std::string suspected, log;
+  for (const auto& s : r.selection.suspected) suspected += s.id + " (" + s.reason + "); ";
+  for (const auto& l : r.selection.log) log += l + "\n";
+  INFO(log << "named: " << named << "; suspected: " << suspected << "; held-out reduction " << r.heldout_rmse_reduction);
+  CHECK(r.selection.selected == std::vector<std::string>{"steer_backlash"});
+  CHECK_THAT(log, Catch::Contains("stable as the steer's dynamics"));
+  for (const char* other : {"steer_lag", "steer_delay"}) {
+    const auto s = std::find_if(r.selection.suspected.begin(), r.selection.suspected.end(),
+                                [&](const SuspectedEffect& e) { return e.id == other; });
+    REQUIRE(s != r.selection.suspected.end());
+    CHECK_THAT(s->reason, Catch::Contains("another form of the steer's dynamics"));
+  }
+  CHECK(r.heldout_rmse_reduction > 0.3);
+}
+
 // The independent generator's exact FIFO steering delay (0.1 s) beside drag along the velocity
 // vector, human-like driver on CCRF. Alone on the nominal, a first-order lag fits the steering a
 // little better than the delay (the missing drag also shows in the yaw rate, which scales with the
@@ -75,6 +101,29 @@ TEST_CASE("a steering delay chosen as a lag before the drag was in the model is 
   for (const auto& l : r.selection.log) log += l + "\n";
   INFO("named: " << named << "\n" << log);
   CHECK_THAT(log, Catch::Contains("round 1: selected steer_lag"));  // the situation the swap is for
+  CHECK_THAT(log, Catch::Contains("swap: steer_delay in place of steer_lag"));
+  CHECK(contains(r.selection.selected, "steer_delay"));
+  CHECK_FALSE(contains(r.selection.selected, "steer_lag"));
+  CHECK(contains(r.selection.selected, "aero_drag"));
+  CHECK(r.selection.final_effects.steer_delay_s == Approx(0.1).margin(0.02));
+}
+
+// The fast case of the one above: 30 s of the same recording's settings.
+TEST_CASE("a steering delay chosen as a lag before the drag was in the model is swapped back on a short recording",
+          "[diagnose]") {
+  const mppi::test::ScratchDir dir("mppi_actuator_swap_short_test");
+  DiagnoseOptions opt;
+  opt.selection.candidates = {"aero_drag", "rolling_resistance", "steer_delay", "steer_lag", "steer_rate_limit", "steer_backlash"};
+  opt.selection.stability_resamples = 0;
+  const DiagnoseResult r = mppi::test::diagnose_independent(
+      mppi::test::independent_recording(dir / "delay_drag.csv", "steer_delay_s=0.1,extra_drag_kgpm=0.5", 2, "ccrf", "ccw",
+                                        "human", 30.0),
+      opt);
+  const std::string named = mppi::test::joined(r.selection.selected);
+  std::string log;
+  for (const auto& l : r.selection.log) log += l + "\n";
+  INFO("named: " << named << "\n" << log);
+  CHECK_THAT(log, Catch::Contains("round 1: selected steer_lag"));
   CHECK_THAT(log, Catch::Contains("swap: steer_delay in place of steer_lag"));
   CHECK(contains(r.selection.selected, "steer_delay"));
   CHECK_FALSE(contains(r.selection.selected, "steer_lag"));

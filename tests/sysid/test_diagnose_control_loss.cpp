@@ -99,3 +99,26 @@ TEST_CASE("a steering play is named on a recording whose car spins before its cr
   CHECK(r.selection.final_effects.steer_backlash == Approx(0.1).margin(0.05));
   CHECK(r.heldout_rmse_reduction > 0.15);
 }
+
+// The fast case of the one above: 20 s (6 crashes); the candidates: the steering's forms of
+// dynamics and map, the tyre, the payload and the drag; two resamples. With the rows of lost
+// control kept in the fits, the play ends at its range limit and a lag is chosen in its place.
+TEST_CASE("a steering play is named on a short recording whose car spins before its crashes", "[diagnose]") {
+  const mppi::test::ScratchDir dir("mppi_control_loss_short_test");
+  const evidence::EvidenceResult rec = mppi::test::independent_recording(dir / "spins.csv", "steer_backlash=0.1", 1,
+                                                                         "marietta", "ccw", "pursuit", 20.0);
+  REQUIRE(rec.crashes >= 3);
+  DiagnoseOptions opt;
+  opt.selection.candidates = {"steer_delay", "steer_lag",    "steer_rate_limit", "steer_backlash", "steer_gain",
+                              "steer_offset", "tire_saturation", "payload",       "aero_drag"};
+  opt.selection.stability_resamples = 2;
+  const DiagnoseResult r = mppi::test::diagnose_independent(rec, opt);
+  const std::string named = mppi::test::joined(r.selection.selected);
+  INFO("named: " << named << "; rows of lost control " << r.control_loss_rows << "; held-out reduction "
+                 << r.heldout_rmse_reduction);
+  CHECK(r.control_loss_rows > 100);
+  REQUIRE(r.selection.selected.size() == 1);
+  CHECK(r.selection.selected[0] == "steer_backlash");
+  CHECK(r.selection.final_effects.steer_backlash == Approx(0.1).margin(0.05));
+  CHECK(r.heldout_rmse_reduction > 0.15);
+}

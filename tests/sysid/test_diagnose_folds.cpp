@@ -112,11 +112,17 @@ sim::Recording throttle_delay_with_a_held_stretch(std::uint64_t seed) {
 
 }  // namespace
 
+// The candidates: the throttle's forms of dynamics and the other longitudinal terms, and the
+// steering's delay and lag; two stability resamples (they judge on the earlier fold too).
 TEST_CASE("an effect the later validation block cannot show is judged on the earlier fold", "[diagnose]") {
   const DiagData d = prepare(throttle_delay_with_a_held_stretch(5), "held throttle");
   const auto family = make_model_family("single-track");
   DiagnoseOptions o;
   o.plots = false;
+  o.selection.candidates = {"throttle_delay", "throttle_lag",      "throttle_rate_limit", "throttle_gain",
+                            "throttle_offset", "motor_voltage_sag", "motor_speed",         "aero_drag",
+                            "rolling_resistance", "steer_delay",    "steer_lag"};
+  o.selection.stability_resamples = 2;
   const DiagnoseResult r = run_diagnosis(d, *family, o);
   std::string log;
   for (const auto& line : r.selection.log) log += line + "\n";

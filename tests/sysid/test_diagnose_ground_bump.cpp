@@ -45,6 +45,36 @@ TEST_CASE("a raised-cosine hill on the track is named as a ground bump at its pl
   CHECK(r.heldout_rmse_reduction > 0.3);
 }
 
+// The fast case of the one above: 30 s on the oval (two passes over the hill, one in the later
+// validation block, one ending in the held-out part); the candidates: the hill, the tilted plane
+// (the cruder account of the same physics), the longitudinal terms and the grip terms; no resamples.
+TEST_CASE("a raised-cosine hill on a short recording is named as a ground bump at its place", "[diagnose]") {
+  const mppi::test::ScratchDir dir("mppi_ground_bump_short_test");
+  const evidence::EvidenceResult rec = mppi::test::independent_recording(
+      dir / "bump.csv", "bump_height_m=0.6,bump_radius_m=12", 4, "gazebo", "ccw", "pursuit", 30.0);
+  std::ifstream truth_file(rec.truth_json);
+  const nlohmann::json truth = nlohmann::json::parse(truth_file);
+  const auto& centre = truth.at("effects").at(0).at("sizes").at("centre_m");
+  const double cx = centre.at(0).get<double>(), cy = centre.at(1).get<double>();
+
+  DiagnoseOptions opt;
+  opt.selection.candidates = {"ground_bump", "road_grade",      "aero_drag",       "rolling_resistance", "payload",
+                              "grip_patch",  "friction_change", "tire_saturation", "throttle_gain",      "motor_speed"};
+  opt.selection.stability_resamples = 0;
+  const DiagnoseResult r = mppi::test::diagnose_independent(rec, opt);
+  const std::string named = mppi::test::joined(r.selection.selected);
+  const EffectParams& e = r.selection.final_effects;
+  INFO("named: " << named << "; truth centre (" << cx << ", " << cy << "); fitted (" << e.bump_x_m << ", "
+                 << e.bump_y_m << "), radius " << e.bump_radius_m << ", height " << e.bump_height_m
+                 << "; held-out reduction " << r.heldout_rmse_reduction);
+  REQUIRE(r.selection.selected.size() == 1);
+  CHECK(r.selection.selected[0] == "ground_bump");
+  CHECK(std::hypot(e.bump_x_m - cx, e.bump_y_m - cy) < 1.5);
+  CHECK(e.bump_radius_m == Approx(12.0).margin(1.5));
+  CHECK(e.bump_height_m == Approx(0.6).margin(0.1));
+  CHECK(r.heldout_rmse_reduction > 0.3);
+}
+
 // A low hill (0.25 m over a 12-m radius) crossed a few times by the human driver on Marietta: on
 // all the data the bump lowers the validation cost by about 10 %. Each stability resample holds
 // only part of the passes over it; a search over places from scratch found the hill elsewhere in

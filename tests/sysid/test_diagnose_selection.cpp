@@ -28,12 +28,16 @@ using namespace mppi::diagnose;
 
 namespace {
 
+// A diagnosis of an open-loop recording of `duration_s` with the hidden effects `truth_text`;
+// `selection`: the selection's options (the fast cases' fewer candidates and resamples).
 DiagnoseResult diagnose_synthetic(const std::string& truth_text, std::uint64_t seed, std::vector<std::string>* ids,
-                                  const std::string& out_dir = "", std::vector<std::string>* progress = nullptr) {
+                                  const std::string& out_dir = "", std::vector<std::string>* progress = nullptr,
+                                  double duration_s = 40.0, const SelectionOptions& selection = {}) {
   EffectParams truth;
   *ids = parse_effect_assignments(truth_text, &truth);
-  const DiagData d = prepare(synthesize_open_loop(truth, seed, 40.0), "synthetic " + truth_text);
+  const DiagData d = prepare(synthesize_open_loop(truth, seed, duration_s), "synthetic " + truth_text);
   DiagnoseOptions o;
+  o.selection = selection;
   o.out_dir = out_dir;
   o.plots = !out_dir.empty();
   if (progress) o.selection.progress = [progress](const std::string& line) { progress->push_back(line); };
@@ -42,13 +46,19 @@ DiagnoseResult diagnose_synthetic(const std::string& truth_text, std::uint64_t s
 
 }  // namespace
 
+// 12-s recordings, against the whole library: every library effect is a candidate (and the three
+// joint ones of partner terms), none is named.
 TEST_CASE("nothing is named on recordings without a hidden effect", "[diagnose]") {
   for (std::uint64_t seed : {3u, 4u, 5u}) {
     std::vector<std::string> ids;
-    const DiagnoseResult r = diagnose_synthetic("", seed, &ids);
+    const DiagnoseResult r = diagnose_synthetic("", seed, &ids, "", nullptr, 12.0);
     INFO("seed " << seed << ": named " << (r.selection.selected.empty() ? "-" : r.selection.selected[0]));
     CHECK(r.selection.selected.empty());
     CHECK(r.headline_after == Approx(r.headline_before));
+    std::size_t library_rows = 0;
+    for (const auto& c : r.selection.candidates) library_rows += c.joint_of.empty();
+    CHECK(library_rows == effect_library().size());
+    CHECK(r.selection.candidates.size() == effect_library().size() + 3);
   }
 }
 
@@ -87,17 +97,25 @@ TEST_CASE("seed x effect sweep: a steering offset is named alone and held-out er
   check_named_alone("steer_offset=0.08");
 }
 
+// A 20-s recording; the candidates: each actuator's forms of dynamics, the partner terms of the
+// three joint candidates, and the drag; two stability resamples.
 TEST_CASE("two hidden effects at once are both named, report and model file agree", "[diagnose]") {
   const auto dir = std::filesystem::temp_directory_path() / "mppi_test_diagnose_two";
   std::filesystem::remove_all(dir);
   std::vector<std::string> ids;
   std::vector<std::string> progress;
-  const DiagnoseResult r = diagnose_synthetic("steer_delay_s=0.08,throttle_lag_s=0.25", 31, &ids, dir.string(), &progress);
+  SelectionOptions selection;
+  selection.candidates = {"steer_delay",   "steer_lag",       "steer_rate_limit", "throttle_delay", "throttle_lag",
+                          "throttle_rate_limit", "steer_gain", "steer_offset",   "throttle_gain",  "throttle_offset",
+                          "motor_freewheel", "drag_brake",    "aero_drag"};
+  selection.stability_resamples = 2;
+  const DiagnoseResult r =
+      diagnose_synthetic("steer_delay_s=0.08,throttle_lag_s=0.25", 31, &ids, dir.string(), &progress, 20.0, selection);
   // Progress: the selection log line by line as it is written, and each stability resample.
   std::vector<std::string> logged, resamples;
   for (const auto& line : progress) (line.rfind("stability: resample ", 0) == 0 ? resamples : logged).push_back(line);
   CHECK(logged == r.selection.log);
-  CHECK(static_cast<int>(resamples.size()) == SelectionOptions{}.stability_resamples);
+  CHECK(static_cast<int>(resamples.size()) == selection.stability_resamples);
   std::vector<std::string> named = r.selection.selected;
   std::sort(named.begin(), named.end());
   std::sort(ids.begin(), ids.end());
@@ -109,10 +127,10 @@ TEST_CASE("two hidden effects at once are both named, report and model file agre
   for (const char* key : {"selected", "effects", "mismatch", "fit_before", "fit_after", "heldout_rmse_before",
                           "heldout_rmse_after", "model_file"})
     CHECK(j.contains(key));
-  // One row per library effect, and the joint candidates (partner terms fitted together) apart.
+  // One row per candidate effect, and the joint candidates (partner terms fitted together) apart.
   std::size_t library_rows = 0, joint_rows = 0;
   for (const auto& e : j["effects"]) (e.contains("joint_of") ? joint_rows : library_rows)++;
-  CHECK(library_rows == effect_library().size());
+  CHECK(library_rows == selection.candidates.size());
   CHECK(joint_rows == 3);  // steering gain+offset, throttle gain+offset, freewheel+drag brake
   CHECK(!j["mismatch"].empty());
   const CorrectedModelFile f = load_corrected_model(j["model_file"].get<std::string>());
@@ -197,6 +215,28 @@ TEST_CASE("four hidden effects at once are all named, in four selection rounds",
   CHECK(r.heldout_rmse_reduction >= 0.5);
 }
 
+// The fast case of the one above: a 30-s recording, the four effects among their rivals (the
+// other forms of each actuator's dynamics, the steering gain, the payload), no resamples.
+TEST_CASE("four hidden effects at once are named in four selection rounds on a short recording", "[diagnose]") {
+  std::vector<std::string> ids;
+  SelectionOptions selection;
+  selection.candidates = {"steer_delay", "steer_lag", "throttle_delay", "throttle_lag", "steer_offset",
+                          "steer_gain",  "tire_saturation", "payload", "aero_drag"};
+  selection.stability_resamples = 0;
+  const DiagnoseResult r = diagnose_synthetic("steer_delay_s=0.08,throttle_lag_s=0.25,steer_offset=0.08,tyre_peak_scale=0.7",
+                                              31, &ids, "", nullptr, 30.0, selection);
+  std::vector<std::string> named = r.selection.selected;
+  std::sort(named.begin(), named.end());
+  std::sort(ids.begin(), ids.end());
+  std::string log;
+  for (const auto& line : r.selection.log) log += line + "\n";
+  INFO(log);
+  CHECK(named == ids);
+  CHECK(std::any_of(r.selection.log.begin(), r.selection.log.end(),
+                    [](const std::string& line) { return line.rfind("round 4: selected", 0) == 0; }));
+  CHECK(r.heldout_rmse_reduction >= 0.5);
+}
+
 TEST_CASE("a straight-line recording cannot name steering or grip effects", "[diagnose]") {
   const DiagData d = prepare(straight_line_drive(5, 40.0), "straight line");
   DiagnoseOptions o;
@@ -234,9 +274,9 @@ TEST_CASE("a parameter at the end of its search range is a bound, not an estimat
 }
 
 TEST_CASE("an effect that the held-out part contradicts is not named and no model is written", "[diagnose]") {
-  // A gyro bias in the first 70 % of the recording only: the training part shows it, the
+  // A gyro bias in the first 70 % of a 20-s recording only: the training part shows it, the
   // held-out part (the last 30 %) does not.
-  DiagData d = prepare(synthesize_open_loop({}, 8, 40.0), "bias that goes away");
+  DiagData d = prepare(synthesize_open_loop({}, 8, 20.0), "bias that goes away");
   const double t_end = d.t.back();
   for (std::size_t k = 0; k < d.rows(); ++k)
     if (d.t[k] < 0.7 * t_end) d.r[k] += 0.08;
@@ -247,6 +287,9 @@ TEST_CASE("an effect that the held-out part contradicts is not named and no mode
   DiagnoseOptions o;
   o.out_dir = out.string();
   o.plots = false;
+  // The candidates: the bias and the terms that also move the yaw rate.
+  o.selection.candidates = {"gyro_bias", "steer_offset",       "steer_asymmetry", "steer_gain",      "steer_delay",
+                            "time_offset", "speed_sensor_scale", "payload",         "tire_saturation", "aero_drag"};
   const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track"), o);
   CHECK_FALSE(r.selection.reliable);
   CHECK(r.selection.selected.empty());
@@ -333,6 +376,39 @@ TEST_CASE("a patch of low grip is named as a place, not as a change in time", "[
   CHECK(r.explained_share[2] > 0.3);  // yaw rate: the grip shows in the turns
 }
 
+// The fast case of the one above: 30 s; the candidates: the patch, the change in time, the
+// tyre and a few other terms the turns show; two resamples.
+TEST_CASE("a patch of low grip on a short recording is named as a place, not as a change in time", "[diagnose]") {
+  const DiagData d = prepare(circles_over_patches(11, 30.0, {{8.0, 0.0}}), "circles over a patch");
+  DiagnoseOptions o;
+  o.plots = false;
+  o.selection.candidates = {"grip_patch", "friction_change", "tire_saturation", "payload", "steer_gain", "steer_delay",
+                            "load_transfer"};
+  o.selection.stability_resamples = 2;
+  const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track"), o);
+  const std::string named = mppi::test::joined(r.selection.selected);
+  std::string log;
+  for (const auto& line : r.selection.log) log += line + "\n";
+  const EffectParams& e = r.selection.final_effects;
+  INFO(log << "named: " << named << "; disc (" << e.patch_x_m << ", " << e.patch_y_m << ", r " << e.patch_radius_m
+           << ", grip " << e.patch_grip_scale << "); held-out reduction " << r.heldout_rmse_reduction);
+  REQUIRE_FALSE(r.selection.selected.empty());
+  CHECK(r.selection.selected[0] == "grip_patch");
+  CHECK(std::find(r.selection.selected.begin(), r.selection.selected.end(), "friction_change") ==
+        r.selection.selected.end());
+  CHECK(std::hypot(e.patch_x_m - 8.0, e.patch_y_m) < 1.5);
+  CHECK(e.patch_radius_m == Approx(3.0).margin(1.0));
+  CHECK(e.patch_grip_scale == Approx(0.5).margin(0.15));
+  CHECK(e.patch2_radius_m == 0.0);
+  CHECK(r.heldout_rmse_reduction > 0.3);
+  auto at_a_place = [](const std::vector<Mismatch>& ms) {
+    return std::any_of(ms.begin(), ms.end(), [](const Mismatch& m) { return m.where.rfind("place", 0) == 0; });
+  };
+  CHECK(at_a_place(r.mismatch));
+  CHECK_FALSE(at_a_place(r.remaining));
+  CHECK(r.explained_share[2] > 0.3);
+}
+
 TEST_CASE("simplicity counts only the parameters a fit moved off their default", "[diagnose]") {
   using mppi::diagnose::FitResult;
   using mppi::diagnose::ParamEstimate;
@@ -386,6 +462,36 @@ TEST_CASE("two patches of one low-grip surface are named as one grip patch with 
   CHECK(r.heldout_rmse_reduction > 0.3);
 }
 
+// The fast case of the one above: 20 s; the candidates of the one-patch fast case, no resamples.
+TEST_CASE("two patches of one low-grip surface on a short recording are named as one grip patch with two discs",
+          "[diagnose]") {
+  const DiagData d = prepare(circles_over_patches(12, 20.0, {{8.0, 0.0}, {-8.0, 0.0}}), "circles over two patches");
+  DiagnoseOptions o;
+  o.plots = false;
+  o.selection.candidates = {"grip_patch", "friction_change", "tire_saturation", "payload", "steer_gain", "steer_delay",
+                            "load_transfer"};
+  o.selection.stability_resamples = 0;
+  const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track"), o);
+  const std::string named = mppi::test::joined(r.selection.selected);
+  const EffectParams& e = r.selection.final_effects;
+  std::string log;
+  for (const auto& line : r.selection.log) log += line + "\n";
+  INFO(log << "named: " << named << "; discs (" << e.patch_x_m << ", " << e.patch_y_m << ", r " << e.patch_radius_m
+                 << "), (" << e.patch2_x_m << ", " << e.patch2_y_m << ", r " << e.patch2_radius_m << "), r3 "
+                 << e.patch3_radius_m << "; held-out reduction " << r.heldout_rmse_reduction);
+  REQUIRE(r.selection.selected.size() == 1);
+  CHECK(r.selection.selected[0] == "grip_patch");
+  REQUIRE(e.patch2_radius_m > 0.0);
+  CHECK(e.patch3_radius_m == 0.0);
+  const double x_first = e.patch_x_m > 0 ? 8.0 : -8.0;
+  CHECK(std::hypot(e.patch_x_m - x_first, e.patch_y_m) < 1.5);
+  CHECK(std::hypot(e.patch2_x_m + x_first, e.patch2_y_m) < 1.5);
+  CHECK(e.patch_radius_m == Approx(3.0).margin(1.0));
+  CHECK(e.patch2_radius_m == Approx(3.0).margin(1.0));
+  CHECK(e.patch_grip_scale == Approx(0.5).margin(0.15));
+  CHECK(r.heldout_rmse_reduction > 0.3);
+}
+
 TEST_CASE("the parallel selection gives the one-thread result", "[diagnose][slow]") {
   // Oracle: the same diagnosis with oneTBB held to one thread (candidates fitted one at a time).
   EffectParams truth;
@@ -398,6 +504,33 @@ TEST_CASE("the parallel selection gives the one-thread result", "[diagnose][slow
     tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
     serial = run_diagnosis(d, *family, DiagnoseOptions{});
   }
+  CHECK(parallel.selection.log == serial.selection.log);
+  CHECK(parallel.selection.selected == serial.selection.selected);
+  REQUIRE(parallel.selection.final_params.size() == serial.selection.final_params.size());
+  for (std::size_t i = 0; i < serial.selection.final_params.size(); ++i)
+    CHECK(parallel.selection.final_params[i].value == serial.selection.final_params[i].value);
+  CHECK(parallel.heldout_rmse_reduction == serial.heldout_rmse_reduction);
+}
+
+// The fast case of the one above: 10 s, the steering's forms of dynamics and a few others as
+// candidates, two resamples (selected on in parallel too).
+TEST_CASE("the parallel selection gives the one-thread result on a short recording", "[diagnose]") {
+  EffectParams truth;
+  parse_effect_assignments("steer_delay_s=0.08", &truth);
+  const DiagData d = prepare(synthesize_open_loop(truth, 41, 10.0), "steering delay, 10 s");
+  const auto family = make_model_family("single-track");
+  DiagnoseOptions o;
+  o.selection.candidates = {"steer_delay", "steer_lag",  "steer_rate_limit", "steer_backlash",
+                            "steer_gain",  "steer_offset", "throttle_lag",   "aero_drag"};
+  o.selection.stability_resamples = 2;
+  const DiagnoseResult parallel = run_diagnosis(d, *family, o);
+  DiagnoseResult serial;
+  {
+    tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+    serial = run_diagnosis(d, *family, o);
+  }
+  INFO("named: " << mppi::test::joined(parallel.selection.selected));
+  CHECK(parallel.selection.selected == std::vector<std::string>{"steer_delay"});
   CHECK(parallel.selection.log == serial.selection.log);
   CHECK(parallel.selection.selected == serial.selection.selected);
   REQUIRE(parallel.selection.final_params.size() == serial.selection.final_params.size());

@@ -97,3 +97,24 @@ TEST_CASE("a PI speed loop in the car is named as the speed loop, with its top s
   CHECK(e.speed_loop_top_speed_mps == Approx(10.0).margin(0.5));
   CHECK(r.heldout_rmse_reduction > 0.8);
 }
+
+// The fast case of the one above: 20 s; the candidates: the loop, its one-parameter rival (the
+// no-load speed), the throttle map's gain and offset, the time offset and the other longitudinal
+// terms; two resamples.
+TEST_CASE("a PI speed loop in the car is named as the speed loop on a short recording", "[diagnose]") {
+  const mppi::test::ScratchDir dir("mppi_speed_loop_short_test");
+  const auto rec = mppi::test::independent_recording(dir / "loop.csv", kLargeLoop, 4, "marietta", "cw", "human", 20.0);
+  DiagnoseOptions opt;
+  opt.selection.candidates = {"speed_loop",   "motor_speed",    "throttle_gain", "throttle_offset",    "time_offset",
+                              "throttle_lag", "throttle_delay", "aero_drag",     "rolling_resistance", "motor_voltage_sag"};
+  opt.selection.stability_resamples = 2;
+  const DiagnoseResult r = mppi::test::diagnose_independent(rec, opt);
+  const std::string named = mppi::test::joined(r.selection.selected);
+  const EffectParams& e = r.selection.final_effects;
+  INFO("named: " << named << "; top speed " << e.speed_loop_top_speed_mps << " m/s, gain " << e.speed_loop_gain
+                 << "; held-out reduction " << r.heldout_rmse_reduction);
+  REQUIRE(r.selection.selected.size() == 1);
+  CHECK(r.selection.selected[0] == "speed_loop");
+  CHECK(e.speed_loop_top_speed_mps == Approx(10.0).margin(0.5));
+  CHECK(r.heldout_rmse_reduction > 0.8);
+}
