@@ -17,7 +17,7 @@
 #include "dynamics/effects.hpp"
 #include "dynamics/model_registry.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "mppi/vehicle_state.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"

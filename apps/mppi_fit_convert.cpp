@@ -6,7 +6,7 @@
 
 #include "cli/app.hpp"
 #include "cli/options.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"
 #include "sysid/real_data.hpp"

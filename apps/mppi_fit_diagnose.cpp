@@ -20,7 +20,7 @@
 #include "cli/options.hpp"
 #include "dynamics/corrected_model.hpp"
 #include "dynamics/effects.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "dynamics/model_registry.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/closed_loop.hpp"

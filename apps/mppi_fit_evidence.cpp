@@ -12,7 +12,7 @@
 #include <thread>
 #include <vector>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sysid/diagnose/evidence_sweep.hpp"
 #include "sysid/evidence/generator.hpp"
 

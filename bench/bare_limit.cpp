@@ -7,11 +7,11 @@
 #include <cstring>
 
 #include "dynamics/mlp.hpp"
-#include "dynamics/npz.hpp"
-#include "mppi/batch.hpp"
-#include "mppi/error.hpp"
-#include "mppi/fast_math.hpp"
-#include "mppi/multiversion.hpp"
+#include "base/npz.hpp"
+#include "base/batch.hpp"
+#include "base/error.hpp"
+#include "base/fast_math.hpp"
+#include "base/multiversion.hpp"
 
 namespace mppi::bench {
 

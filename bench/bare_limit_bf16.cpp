@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <cstring>
 
-#include "mppi/fast_math.hpp"
+#include "base/fast_math.hpp"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>

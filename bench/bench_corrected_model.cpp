@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "dynamics/with_effects.hpp"
-#include "mppi/batch.hpp"
-#include "mppi/multiversion.hpp"
+#include "base/batch.hpp"
+#include "base/multiversion.hpp"
 
 namespace {
 

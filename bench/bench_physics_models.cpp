@@ -10,8 +10,8 @@
 #include "dynamics/double_track.hpp"
 #include "dynamics/full_vehicle.hpp"
 #include "dynamics/single_track.hpp"
-#include "mppi/batch.hpp"
-#include "mppi/multiversion.hpp"
+#include "base/batch.hpp"
+#include "base/multiversion.hpp"
 
 namespace {
 

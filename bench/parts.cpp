@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cstddef>
 
-#include "mppi/batch.hpp"
-#include "mppi/multiversion.hpp"
+#include "base/batch.hpp"
+#include "base/multiversion.hpp"
 
 namespace mppi::bench {
 

@@ -30,7 +30,7 @@
 #include "dynamics/autorally_nn.hpp"
 #include "mppi/controller.hpp"
 #include "mppi/cpu_backend.hpp"
-#include "mppi/multiversion.hpp"
+#include "base/multiversion.hpp"
 #include "mppi/noise.hpp"
 #include "peer_workload.hpp"
 

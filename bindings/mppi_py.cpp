@@ -27,7 +27,7 @@
 #include "dynamics/vehicle_params.hpp"
 #include "dynamics/model_registry.hpp"
 #include "mppi/controller.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/recording.hpp"

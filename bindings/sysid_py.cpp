@@ -17,7 +17,7 @@
 
 #include "dynamics/vehicle_params.hpp"
 #include "dynamics/model_registry.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/recording.hpp"
 #include "sysid/bifilar.hpp"

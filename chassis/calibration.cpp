@@ -5,7 +5,7 @@
 #include <map>
 
 #include "chassis/yaml_util.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::chassis {
 

@@ -4,7 +4,7 @@
 #include <set>
 
 #include "chassis/yaml_util.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::chassis {
 

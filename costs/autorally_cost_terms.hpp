@@ -11,7 +11,7 @@
 // function in kernels/shaders/cost.glsl reading a CostState.
 #include <algorithm>
 
-#include "mppi/type_list.hpp"
+#include "base/type_list.hpp"
 
 namespace mppi {
 

@@ -14,7 +14,7 @@
 #include <utility>
 #include <vector>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi {
 

@@ -18,8 +18,8 @@
 
 #include "costs/cost_map.hpp"
 #include "costs/python_dict_text.hpp"
-#include "dynamics/npz.hpp"
-#include "mppi/error.hpp"
+#include "base/npz.hpp"
+#include "base/error.hpp"
 
 namespace mppi {
 

@@ -22,8 +22,8 @@
 
 #include "costs/cost_map.hpp"
 #include "dynamics/fast_trig.hpp"
-#include "mppi/batch.hpp"
-#include "mppi/error.hpp"
+#include "base/batch.hpp"
+#include "base/error.hpp"
 
 namespace mppi {
 

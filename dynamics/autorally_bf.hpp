@@ -21,9 +21,9 @@
 #include <string>
 
 #include "dynamics/fast_trig.hpp"
-#include "dynamics/npz.hpp"
-#include "mppi/batch.hpp"
-#include "mppi/error.hpp"
+#include "base/npz.hpp"
+#include "base/batch.hpp"
+#include "base/error.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi {

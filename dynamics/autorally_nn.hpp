@@ -25,7 +25,7 @@
 
 #include "dynamics/fast_trig.hpp"
 #include "dynamics/mlp.hpp"
-#include "mppi/batch.hpp"
+#include "base/batch.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi {

@@ -2,8 +2,8 @@
 #include <cmath>
 
 #include "dynamics/autorally_nn.hpp"
-#include "dynamics/npz.hpp"
-#include "mppi/error.hpp"
+#include "base/npz.hpp"
+#include "base/error.hpp"
 
 namespace mppi {
 

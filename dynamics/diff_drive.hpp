@@ -14,8 +14,8 @@
 #include <string>
 
 #include "dynamics/fast_trig.hpp"
-#include "mppi/batch.hpp"
-#include "mppi/error.hpp"
+#include "base/batch.hpp"
+#include "base/error.hpp"
 
 namespace mppi {
 

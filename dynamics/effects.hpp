@@ -82,8 +82,8 @@
 #include <vector>
 
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/error.hpp"
-#include "mppi/param_table.hpp"
+#include "base/error.hpp"
+#include "base/param_table.hpp"
 
 namespace mppi {
 

@@ -35,8 +35,8 @@
 
 #include "dynamics/double_track.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/batch.hpp"
-#include "mppi/error.hpp"
+#include "base/batch.hpp"
+#include "base/error.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi {

@@ -3,8 +3,8 @@
 #include <cmath>
 
 #include "dynamics/mlp.hpp"
-#include "dynamics/npz.hpp"
-#include "mppi/error.hpp"
+#include "base/npz.hpp"
+#include "base/error.hpp"
 
 namespace mppi {
 

@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "mppi/concepts.hpp"
-#include "mppi/param_table.hpp"
+#include "base/param_table.hpp"
 
 namespace mppi {
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "dynamics/model_descriptor.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "mppi/model_list.hpp"  // generated: RegisteredModels
 
 namespace mppi {

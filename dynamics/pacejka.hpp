@@ -9,7 +9,7 @@
 #include <string>
 
 #include "dynamics/fast_trig.hpp"
-#include "mppi/fast_math.hpp"
+#include "base/fast_math.hpp"
 
 namespace mppi {
 

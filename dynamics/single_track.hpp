@@ -27,9 +27,9 @@
 #include "dynamics/fast_trig.hpp"
 #include "dynamics/pacejka.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/batch.hpp"
-#include "mppi/error.hpp"
-#include "mppi/fast_math.hpp"
+#include "base/batch.hpp"
+#include "base/error.hpp"
+#include "base/fast_math.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi {

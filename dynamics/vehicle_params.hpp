@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "dynamics/pacejka.hpp"
-#include "mppi/param_table.hpp"
+#include "base/param_table.hpp"
 
 namespace mppi {
 

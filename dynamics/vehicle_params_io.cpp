@@ -1,5 +1,5 @@
 // YAML <-> the physics models' parameters, through their parameter tables
-// (dynamics/vehicle_params.hpp, mppi/param_yaml.hpp): strict, every mistake is an mppi::Error
+// (dynamics/vehicle_params.hpp, base/param_yaml.hpp): strict, every mistake is an mppi::Error
 // naming the file, line and key.
 #include <string>
 #include <vector>
@@ -9,8 +9,8 @@
 #include "dynamics/models/kinematic.hpp"
 #include "dynamics/models/single_track.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/error.hpp"
-#include "mppi/param_yaml.hpp"
+#include "base/error.hpp"
+#include "base/param_yaml.hpp"
 
 namespace mppi {
 

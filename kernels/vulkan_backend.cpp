@@ -13,7 +13,7 @@
 
 #include "kernels/vulkan_api.hpp"
 #include "mppi/cpu_backend.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 // SPIR-V made at build time by glslangValidator (kernels/CMakeLists.txt), checked by spirv-val.
 #include "costs/autorally_cost_gpu.hpp"

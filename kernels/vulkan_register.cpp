@@ -7,7 +7,7 @@
 
 #include "kernels/vulkan_backend.hpp"
 #include "mppi/backend_registry.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::vulkan {
 namespace {

@@ -3,7 +3,7 @@
 // what was actually used and why (kernels/make_controller.hpp does the choosing).
 #include <string>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi {
 

@@ -18,10 +18,10 @@
 #endif
 
 #include "mppi/backend.hpp"
-#include "mppi/batch.hpp"
+#include "base/batch.hpp"
 #include "mppi/concepts.hpp"
-#include "mppi/error.hpp"
-#include "mppi/multiversion.hpp"
+#include "base/error.hpp"
+#include "base/multiversion.hpp"
 #include "mppi/noise.hpp"
 #include "mppi/sample_step.hpp"
 #include "mppi/thread_schedule.hpp"

@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "mppi/backend.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi {
 

@@ -19,7 +19,7 @@
 #include "dynamics/model_registry.hpp"
 #include "dynamics/four_wheel_observe.hpp"
 #include "mppi/controller.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "mppi/make_controller.hpp"
 #include "sim/crash_detector.hpp"
 #include "sim/data_dir.hpp"

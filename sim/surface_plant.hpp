@@ -9,7 +9,7 @@
 #include <memory>
 
 #include "dynamics/single_track.hpp"
-#include "mppi/batch.hpp"
+#include "base/batch.hpp"
 #include "sim/surface_map.hpp"
 
 namespace mppi::sim {

@@ -7,7 +7,7 @@
 
 #include <Eigen/Dense>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::sysid {
 

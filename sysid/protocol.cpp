@@ -12,7 +12,7 @@
 
 #include "dynamics/full_vehicle.hpp"
 #include "dynamics/model_registry.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/plant.hpp"
 
 namespace mppi::sysid {

@@ -31,7 +31,7 @@
 #include "costs/cost_map.hpp"
 #include "dynamics/models/single_track.hpp"
 #include "mppi/controller.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/crash_detector.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/geometry.hpp"

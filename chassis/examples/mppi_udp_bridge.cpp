@@ -16,7 +16,7 @@
 #include "cli/options.hpp"
 #include "dynamics/single_track.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/lap_counter.hpp"
 #include "sim/plant.hpp"

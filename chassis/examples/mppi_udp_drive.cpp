@@ -24,7 +24,7 @@
 #include "dynamics/kinematic_bicycle.hpp"
 #include "dynamics/model_registry.hpp"
 #include "mppi/controller.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/lap_counter.hpp"
 #include "sim/track.hpp"

@@ -6,7 +6,7 @@
 
 #include "dynamics/autorally_bf.hpp"
 #include "dynamics/model_descriptor.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::models {
 

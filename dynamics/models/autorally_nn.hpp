@@ -7,7 +7,7 @@
 
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/model_descriptor.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::models {
 

@@ -1,5 +1,5 @@
 // Shared by the compute shaders: the branch-free float math and the Philox4x32-10 noise of the
-// CPU backend (mppi/fast_math.hpp, dynamics/fast_trig.hpp, mppi/noise.hpp), written with the
+// CPU backend (base/fast_math.hpp, dynamics/fast_trig.hpp, mppi/noise.hpp), written with the
 // same operations in the same order, so that the device agrees with the CPU to float rounding.
 #ifndef MPPI_COMMON_GLSL
 #define MPPI_COMMON_GLSL

@@ -13,7 +13,7 @@
 #include "plot/figure_json.hpp"
 #include "plot/html_report.hpp"
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sysid/diagnose/control_loss.hpp"
 #include "sysid/diagnose/plots.hpp"
 

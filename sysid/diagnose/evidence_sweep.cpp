@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sysid/evidence/truth_effects.hpp"
 
 namespace mppi::diagnose {

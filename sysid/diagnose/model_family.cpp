@@ -5,7 +5,7 @@
 
 #include "dynamics/with_effects.hpp"
 #include "dynamics/model_registry.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/data_dir.hpp"
 
 namespace mppi::diagnose {

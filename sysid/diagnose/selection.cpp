@@ -13,7 +13,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sysid/diagnose/fit.hpp"
 #include "sysid/diagnose/identifiability.hpp"
 #include "sysid/diagnose/joint_refit.hpp"

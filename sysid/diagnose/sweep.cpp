@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::diagnose {
 namespace {

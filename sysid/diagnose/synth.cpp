@@ -9,7 +9,7 @@
 #include <random>
 #include <sstream>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "dynamics/model_registry.hpp"
 #include "dynamics/with_effects.hpp"
 #include "sim/closed_loop.hpp"

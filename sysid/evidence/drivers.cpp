@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/geometry.hpp"
 
 namespace mppi::evidence {

@@ -11,7 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/crash_detector.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/geometry.hpp"

@@ -4,7 +4,7 @@
 #include <sstream>
 #include <utility>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::evidence {
 namespace {

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "costs/cost_config.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "error_of.hpp"
 #include "test_data.hpp"
 

@@ -16,8 +16,8 @@
 
 #include "costs/cost_map.hpp"
 #include "costs/python_dict_text.hpp"
-#include "dynamics/npz.hpp"
-#include "mppi/error.hpp"
+#include "base/npz.hpp"
+#include "base/error.hpp"
 #include "error_of.hpp"
 #include "test_data.hpp"
 

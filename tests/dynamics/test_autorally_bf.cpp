@@ -17,7 +17,7 @@
 #include "costs/autorally_cost.hpp"
 #include "costs/cost_map.hpp"
 #include "dynamics/models/autorally_bf.hpp"
-#include "dynamics/npz.hpp"
+#include "base/npz.hpp"
 #include "mppi/make_controller.hpp"
 #include "sim/closed_loop.hpp"
 #include "test_data.hpp"

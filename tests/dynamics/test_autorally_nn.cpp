@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "dynamics/autorally_nn.hpp"
-#include "dynamics/npz.hpp"
+#include "base/npz.hpp"
 #include "mppi/concepts.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "test_data.hpp"
 
 static_assert(mppi::Dynamics<mppi::AutoRallyNetwork>);

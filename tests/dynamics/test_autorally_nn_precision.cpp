@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "dynamics/autorally_nn.hpp"
-#include "mppi/batch.hpp"
+#include "base/batch.hpp"
 #include "test_data.hpp"
 
 namespace {

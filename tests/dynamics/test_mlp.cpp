@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "dynamics/mlp.hpp"
-#include "dynamics/npz.hpp"
-#include "mppi/error.hpp"
+#include "base/npz.hpp"
+#include "base/error.hpp"
 #include "test_data.hpp"
 
 namespace {

@@ -1,7 +1,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "mppi/fast_math.hpp"
+#include "base/fast_math.hpp"
 
 TEST_CASE("fast_tanh, fast_log and fast_sincos_turns against libm", "[core][math]") {
   double tanh_err = 0, log_err = 0, trig_err = 0;

@@ -4,7 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include "dynamics/kinematic_bicycle.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/plant.hpp"
 
 using namespace mppi;

@@ -12,7 +12,7 @@
 
 #include "dynamics/single_track.hpp"
 #include "dynamics/with_effects.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/recording.hpp"
 #include "sim/surface_map.hpp"

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/recording.hpp"
 #include "sysid/diagnose/synth.hpp"

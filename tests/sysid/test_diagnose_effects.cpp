@@ -11,7 +11,7 @@
 #include "dynamics/corrected_model.hpp"
 #include "dynamics/with_effects.hpp"
 #include "dynamics/single_track.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sysid/diagnose/data.hpp"
 #include "sysid/diagnose/effects.hpp"
 #include "sysid/diagnose/fit.hpp"

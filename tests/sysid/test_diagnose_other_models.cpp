@@ -10,7 +10,7 @@
 #include <fstream>
 
 #include "dynamics/with_effects.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sysid/diagnose/diagnose.hpp"
 #include "sysid/diagnose/model_family.hpp"
 #include "sysid/diagnose/synth.hpp"

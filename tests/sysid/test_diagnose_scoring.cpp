@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sysid/diagnose/replay.hpp"
 #include "sysid/diagnose/sweep.hpp"
 #include "sysid/diagnose/synth.hpp"

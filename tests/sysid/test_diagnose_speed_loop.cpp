@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sysid/diagnose/data.hpp"
 #include "sysid/diagnose/diagnose.hpp"
 #include "sysid/diagnose/evidence_sweep.hpp"

@@ -13,7 +13,7 @@
 #include <sstream>
 
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/recording.hpp"
 #include "sysid/diagnose/data.hpp"

@@ -7,7 +7,7 @@
 #include <random>
 
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sysid/vehicle_estimation.hpp"
 
 using namespace mppi;

@@ -1,4 +1,4 @@
-#include "mppi/param_yaml.hpp"
+#include "base/param_yaml.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -8,8 +8,8 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "mppi/error.hpp"
-#include "mppi/yaml_number.hpp"
+#include "base/error.hpp"
+#include "base/yaml_number.hpp"
 
 namespace mppi {
 

@@ -1,7 +1,7 @@
 // NumPy .npz reader: libzip for the archive, a small hand-written parser for the .npy header.
 // Every check is against the bytes actually read, so truncated or corrupt files end in an
 // mppi::Error and never in an out-of-bounds read or a huge allocation.
-#include "dynamics/npz.hpp"
+#include "base/npz.hpp"
 
 #include <zip.h>
 
@@ -12,7 +12,7 @@
 #include <memory>
 #include <string_view>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi {
 

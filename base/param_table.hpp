@@ -1,7 +1,7 @@
 #pragma once
 // A component's parameters as one table: YAML key, where the value lives, unit, valid range,
 // and a doc line. The table is declared once, next to the component (its descriptor), and the
-// YAML loader and writer (mppi/param_yaml.hpp), the range part of is_valid(), the estimators'
+// YAML loader and writer (base/param_yaml.hpp), the range part of is_valid(), the estimators'
 // named-parameter vectors and the --help text all come from it. Defaults are the values of a
 // default-constructed parameter struct.
 //

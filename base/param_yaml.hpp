@@ -1,12 +1,12 @@
 #pragma once
-// YAML <-> parameter tables (mppi/param_table.hpp), strict: an unknown or repeated key, a value
+// YAML <-> parameter tables (base/param_table.hpp), strict: an unknown or repeated key, a value
 // that is not a finite number, or one out of its range throws mppi::Error naming the source
 // (file), line and key. Keys "outer.inner" of a table are read from and written to a nested
 // map `outer: {inner: ..}`.
 #include <string>
 #include <vector>
 
-#include "mppi/param_table.hpp"
+#include "base/param_table.hpp"
 
 namespace YAML {
 class Node;

@@ -1,10 +1,10 @@
-#include "mppi/yaml_number.hpp"
+#include "base/yaml_number.hpp"
 
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi {
 
