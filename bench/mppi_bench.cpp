@@ -43,7 +43,7 @@
 #include "bare_limit.hpp"
 #include "parts.hpp"
 #include "costs/autorally_cost.hpp"
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "mppi/controller.hpp"
 #include "mppi/cpu_backend.hpp"

@@ -1,6 +1,6 @@
 #pragma once
 // Kernels for the "parts" benchmarks that the library has no public entry point for.
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 
 namespace mppi::bench {
 

@@ -10,7 +10,7 @@
 #include <memory>
 #include <vector>
 
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "costs/goal_obstacle_cost.hpp"
 #include "dynamics/diff_drive.hpp"
 #include "mppi/controller_options.hpp"

@@ -18,7 +18,7 @@
 
 #include "costs/autorally_cost.hpp"
 #include "costs/cost_config.hpp"
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "costs/goal_obstacle_cost.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/diff_drive.hpp"

@@ -15,7 +15,7 @@
 #include <utility>
 
 #include "costs/autorally_cost_terms.hpp"
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "base/batch.hpp"
 #include "base/param_table.hpp"
 #include "base/error.hpp"

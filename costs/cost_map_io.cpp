@@ -16,7 +16,7 @@
 #include <opencv2/imgcodecs.hpp>
 #pragma GCC diagnostic pop
 
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "costs/python_dict_text.hpp"
 #include "base/npz.hpp"
 #include "base/error.hpp"

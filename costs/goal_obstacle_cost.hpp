@@ -20,7 +20,7 @@
 #include <utility>
 #include <vector>
 
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "dynamics/fast_trig.hpp"
 #include "base/batch.hpp"
 #include "base/error.hpp"

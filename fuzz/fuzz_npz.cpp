@@ -1,7 +1,7 @@
 // NumPy .npz reader (base/npz.cpp, libzip) and the readers of what it holds: the AutoRally
 // cost map (costs/cost_map_io.cpp), network weights (dynamics/autorally_nn_load.cpp) and the
 // basis-function model (dynamics/autorally_bf.hpp).
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "dynamics/autorally_bf.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "base/npz.hpp"

@@ -13,7 +13,7 @@
 #include "chassis/sim_adapter.hpp"
 #include "costs/autorally_cost.hpp"
 #include "costs/cost_config.hpp"
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "dynamics/corrected_model.hpp"
 #include "dynamics/with_effects.hpp"
 #include "dynamics/model_registry.hpp"

@@ -28,7 +28,7 @@
 #include "chassis/udp_adapter.hpp"
 #include "costs/autorally_cost.hpp"
 #include "costs/cost_config.hpp"
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "dynamics/models/single_track.hpp"
 #include "mppi/controller.hpp"
 #include "base/error.hpp"

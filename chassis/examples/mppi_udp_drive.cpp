@@ -19,7 +19,7 @@
 #include "cli/options.hpp"
 #include "costs/autorally_cost.hpp"
 #include "costs/cost_config.hpp"
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
 #include "dynamics/model_registry.hpp"

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "costs/python_dict_text.hpp"
 #include "base/npz.hpp"
 #include "base/error.hpp"

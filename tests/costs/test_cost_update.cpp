@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "costs/autorally_cost.hpp"
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
 #include "mppi/controller.hpp"
 #include "mppi/cpu_backend.hpp"

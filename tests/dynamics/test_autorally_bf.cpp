@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "costs/autorally_cost.hpp"
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "dynamics/models/autorally_bf.hpp"
 #include "base/npz.hpp"
 #include "mppi/make_controller.hpp"

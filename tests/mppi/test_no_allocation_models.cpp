@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "costs/autorally_cost.hpp"
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "dynamics/model_registry.hpp"
 #include "dynamics/with_effects.hpp"
 #include "mppi/make_controller.hpp"

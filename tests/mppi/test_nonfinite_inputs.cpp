@@ -9,7 +9,7 @@
 #include <string>
 
 #include "costs/cost_config.hpp"
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/vehicle_params.hpp"
 #include "tests/error_of.hpp"

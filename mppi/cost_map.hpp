@@ -4,7 +4,8 @@
 //   col = floor((x - x_min) * ppm), row = floor((y - y_min) * ppm), value = values[row * W + col]
 // with W = (x_max - x_min) * ppm and H = (y_max - y_min) * ppm; row 0 is at y_min. Outside the
 // map the nearest edge pixel is used (clamp-to-edge, like AutoRally's GPU texture). Values are
-// 0 on the centreline, about 1 at the track edge, more outside.
+// 0 on the centreline, about 1 at the track edge, more outside. The controller hands it to its
+// backends (Backend::set_cost_map); the file loaders below are in costs/cost_map_io.cpp.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
