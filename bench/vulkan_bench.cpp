@@ -24,7 +24,7 @@
 #include "mppi/cost_map.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
-#include "kernels/make_controller.hpp"
+#include "factory/make_controller.hpp"
 #include "kernels/vulkan_backend.hpp"
 #include "mppi/controller.hpp"
 

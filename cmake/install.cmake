@@ -2,7 +2,7 @@
 # package so that an out-of-tree project can do find_package(mppi) and link mppi::core etc.
 include(CMakePackageConfigHelpers)
 
-foreach(folder IN ITEMS base mppi dynamics costs sim chassis plot)
+foreach(folder IN ITEMS base mppi dynamics costs factory sim chassis plot)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${folder}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/${folder}
           FILES_MATCHING PATTERN "*.hpp")
 endforeach()

@@ -17,7 +17,7 @@
 #include "dynamics/kinematic_bicycle.hpp"
 #include "dynamics/single_track.hpp"
 #include "mppi/backend.hpp"
-#include "mppi/gpu_twin.hpp"
+#include "factory/gpu_twin.hpp"
 
 namespace mppi::vulkan {
 
@@ -45,7 +45,7 @@ Probe probe();
 int pick_device(const Probe& probe, bool allow_cpu, std::string* why);
 
 // A model as the shaders see it: its kernel, state size and parameter floats, made from the
-// model's descriptor (mppi/gpu_twin.hpp).
+// model's descriptor (factory/gpu_twin.hpp).
 using TwinModel = GpuModel;
 // The GPU twin of a model, or nullopt and why (e.g. a network of another shape).
 template <class M>

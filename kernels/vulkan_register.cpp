@@ -1,4 +1,4 @@
-// The Vulkan backend enters the backend registry (mppi/backend_registry.hpp) when the program
+// The Vulkan backend enters the backend registry (factory/backend_registry.hpp) when the program
 // starts: make_controller() then offers it for every model with a GPU twin. The exported symbol
 // below is what the library's link interface names (--undefined) so that this object is linked.
 #include <cstdlib>
@@ -6,7 +6,7 @@
 #include <string>
 
 #include "kernels/vulkan_backend.hpp"
-#include "mppi/backend_registry.hpp"
+#include "factory/backend_registry.hpp"
 #include "base/error.hpp"
 
 namespace mppi::vulkan {

@@ -1,6 +1,6 @@
 #pragma once
 // Which backend runs the rollouts: asked for by the user (mppi-sim --backend, the API), and
-// what was actually used and why (kernels/make_controller.hpp does the choosing).
+// what was actually used and why (factory/make_controller.hpp does the choosing).
 #include <string>
 
 #include "base/error.hpp"

@@ -18,7 +18,7 @@
 #include "mppi/cost_map.hpp"
 #include "dynamics/models/autorally_bf.hpp"
 #include "base/npz.hpp"
-#include "mppi/make_controller.hpp"
+#include "factory/make_controller.hpp"
 #include "sim/closed_loop.hpp"
 #include "test_data.hpp"
 

@@ -12,7 +12,7 @@
 #include "mppi/cost_map.hpp"
 #include "dynamics/model_registry.hpp"
 #include "dynamics/with_effects.hpp"
-#include "mppi/make_controller.hpp"
+#include "factory/make_controller.hpp"
 #include "test_data.hpp"
 #include "tests/mppi/allocation_counter.hpp"
 

@@ -19,7 +19,8 @@
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
 #include "dynamics/single_track.hpp"
-#include "kernels/make_controller.hpp"
+#include "factory/make_controller.hpp"
+#include "kernels/vulkan_backend.hpp"
 #include "mppi/controller.hpp"
 #include "vulkan/vulkan_test_util.hpp"
 

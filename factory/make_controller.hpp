@@ -6,7 +6,7 @@
 //   auto   -> a real GPU (discrete first) through a registered GPU backend, else the CPU backend
 //   cpu    -> the CPU backend
 //   vulkan -> any Vulkan device, a CPU one (lavapipe) included, else the CPU backend
-// GPU backends (kernels/) register themselves when linked (mppi/backend_registry.hpp); a model
+// GPU backends (kernels/) register themselves when linked (factory/backend_registry.hpp); a model
 // runs on them if its descriptor declares a GPU twin (dynamics/models/*.hpp) and the cost is
 // the AutoRally cost. MPPI_VULKAN_DEVICE=<index or part of the name> picks the Vulkan device.
 #include <string>
@@ -14,9 +14,9 @@
 #include <utility>
 
 #include "mppi/backend_choice.hpp"
-#include "mppi/backend_registry.hpp"
+#include "factory/backend_registry.hpp"
 #include "mppi/controller.hpp"
-#include "mppi/gpu_twin.hpp"
+#include "factory/gpu_twin.hpp"
 
 namespace mppi {
 

@@ -1,7 +1,7 @@
 #pragma once
 // Rollout backends other than the CPU one (kernels/: Vulkan) register themselves here when
 // their library is linked (a static registrar in the backend's library; the library's link
-// interface keeps that object in the program). make_controller() (mppi/make_controller.hpp)
+// interface keeps that object in the program). make_controller() (factory/make_controller.hpp)
 // asks them in registration order.
 #include <functional>
 #include <memory>
@@ -12,7 +12,7 @@
 #include "mppi/backend.hpp"
 #include "mppi/backend_choice.hpp"
 #include "mppi/controller_options.hpp"
-#include "mppi/gpu_twin.hpp"
+#include "factory/gpu_twin.hpp"
 
 namespace mppi {
 
