@@ -31,7 +31,7 @@ inline float fast_tanh(float x) noexcept {
 // dynamics/mlp_avx512_kernels.hpp): x P(x^2) / Q(x^2), an odd [9/6] minimax rational (Q
 // monic), same clamp: 8 multiplies or FMAs, one add and a division against 11 and one. Max abs
 // error 4.5e-7 (tests/mppi/test_fast_math.cpp). fast_tanh stays as it is: the GPU shaders
-// (kernels/shaders/common.glsl) repeat its operations for CPU/GPU parity.
+// (vulkan/shaders/common.glsl) repeat its operations for CPU/GPU parity.
 inline constexpr float kTanhClamp = 7.90531110763549805f;
 inline constexpr float kTanhP[5] = {5091.705421197275f, 647.0683863962777f, 13.712402210685147f,
                                     0.036392489380047646f, -3.1233200292516504e-05f};

@@ -25,7 +25,7 @@
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
 #include "factory/make_controller.hpp"
-#include "kernels/vulkan_backend.hpp"
+#include "vulkan/vulkan_backend.hpp"
 #include "mppi/controller.hpp"
 
 namespace {

@@ -10,7 +10,7 @@
 //                                                   its state from a simulated car's state
 // optionally its YAML parameter table
 //   using Params; static std::vector<ParamField> params(Params&); static Model make(const Params&);
-// and optionally a GPU twin (kernels/): the GLSL file kernels/shaders/models/<kGpuKernel>.glsl
+// and optionally a GPU twin (vulkan/): the GLSL file vulkan/shaders/models/<kGpuKernel>.glsl
 // and the floats of the parameter block it reads, named as the GLSL code names them
 //   static constexpr const char* kGpuKernel;
 //   static std::vector<GpuField<Model>> gpu_fields();

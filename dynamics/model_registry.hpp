@@ -59,7 +59,7 @@ inline std::string models_help() {
         out += "  " + table.substr(begin, end - begin + 1);
       }
     }
-    if constexpr (HasGpuTwin<D>) out += std::string("  GPU twin: kernels/shaders/models/") + D::kGpuKernel + ".glsl\n";
+    if constexpr (HasGpuTwin<D>) out += std::string("  GPU twin: vulkan/shaders/models/") + D::kGpuKernel + ".glsl\n";
   });
   return out;
 }

@@ -1,5 +1,5 @@
 #pragma once
-// Rollout backends other than the CPU one (kernels/: Vulkan) register themselves here when
+// Rollout backends other than the CPU one (vulkan/: Vulkan) register themselves here when
 // their library is linked (a static registrar in the backend's library; the library's link
 // interface keeps that object in the program). make_controller() (factory/make_controller.hpp)
 // asks them in registration order.

@@ -1,6 +1,6 @@
 #pragma once
 // A model as a GPU backend sees it, built from the model's descriptor (dynamics/models/*.hpp):
-// the kernel id (kernels/shaders/models/<kernel>.glsl), the state size, and the floats of the
+// the kernel id (vulkan/shaders/models/<kernel>.glsl), the state size, and the floats of the
 // parameter block in the order of the descriptor's gpu_fields() (whose names the build turns
 // into the GLSL #defines the kernel reads), then the descriptor's tail arrays.
 #include <optional>
@@ -12,7 +12,7 @@
 namespace mppi {
 
 struct GpuModel {
-  std::string kernel;            // kernels/shaders/models/<kernel>.glsl
+  std::string kernel;            // vulkan/shaders/models/<kernel>.glsl
   int num_states = 0;
   int constant_a = 1, constant_b = 1;  // shader constants of the kernel (e.g. hidden sizes)
   std::vector<float> params;     // named floats (gpu_fields order), then the tail

@@ -6,7 +6,7 @@
 //   auto   -> a real GPU (discrete first) through a registered GPU backend, else the CPU backend
 //   cpu    -> the CPU backend
 //   vulkan -> any Vulkan device, a CPU one (lavapipe) included, else the CPU backend
-// GPU backends (kernels/) register themselves when linked (factory/backend_registry.hpp); a model
+// GPU backends (vulkan/) register themselves when linked (factory/backend_registry.hpp); a model
 // runs on them if its descriptor declares a GPU twin (dynamics/models/*.hpp) and the cost is
 // the AutoRally cost. MPPI_VULKAN_DEVICE=<index or part of the name> picks the Vulkan device.
 #include <string>
@@ -37,7 +37,7 @@ Controller make_controller(D model, C cost, const ControllerOptions& options, Ba
       if (!twin) {
         r.reason = why.find("GPU twin") != std::string::npos ? why : "no GPU twin: " + why;
       } else if (backend_factories().empty()) {
-        r.reason = "built without a GPU backend (kernels/)";
+        r.reason = "built without a GPU backend (vulkan/)";
       } else {
         for (const BackendFactory& factory : backend_factories()) {
           auto backend = factory.make(*twin, cost, options, choice == BackendChoice::kVulkan, &r);

@@ -24,7 +24,7 @@ struct AutoRallyBasisFunctions {
     std::copy(px, px + state::kCommonStates, mx);
   }
 
-  // GPU twin: kernels/shaders/models/autorally_bf.glsl reads W (4 x 25, row-major) after the
+  // GPU twin: vulkan/shaders/models/autorally_bf.glsl reads W (4 x 25, row-major) after the
   // named floats.
   static constexpr const char* kGpuKernel = "autorally_bf";
   static std::vector<GpuField<Model>> gpu_fields() { return {}; }

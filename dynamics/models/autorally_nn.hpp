@@ -25,7 +25,7 @@ struct AutoRallyNetworkModel {
     std::copy(px, px + state::kCommonStates, mx);
   }
 
-  // GPU twin: kernels/shaders/models/autorally_nn.glsl, a 6-H1-H2-4 tanh-tanh-linear MLP. Each
+  // GPU twin: vulkan/shaders/models/autorally_nn.glsl, a 6-H1-H2-4 tanh-tanh-linear MLP. Each
   // layer as W with every row padded to a multiple of 4 floats, then b padded to a multiple of
   // 4 (the shader reads 4 weights at a time); H1, H2 are shader constants.
   static constexpr const char* kGpuKernel = "autorally_nn";

@@ -32,7 +32,7 @@ struct Kinematic {
     mx[state::kVy] = 0.f;
   }
 
-  // GPU twin: kernels/shaders/models/kinematic.glsl (as KinematicBicycle's constructor computes them).
+  // GPU twin: vulkan/shaders/models/kinematic.glsl (as KinematicBicycle's constructor computes them).
   static constexpr const char* kGpuKernel = "kinematic";
   static std::vector<GpuField<Model>> gpu_fields() {
     return {{"K_INV_WHEELBASE", [](const Model& m) { return static_cast<float>(1 / m.params().wheelbase_m); }},

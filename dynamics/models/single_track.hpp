@@ -38,7 +38,7 @@ struct SingleTrackModel {
     mx[Model::kOmegaFront] = mx[Model::kOmegaRear] = px[state::kVx] / radius;
   }
 
-  // GPU twin: kernels/shaders/models/single_track.glsl, in SingleTrackCoeffs<float> terms.
+  // GPU twin: vulkan/shaders/models/single_track.glsl, in SingleTrackCoeffs<float> terms.
   static constexpr const char* kGpuKernel = "single_track";
   static std::vector<GpuField<Model>> gpu_fields() {
 #define MPPI_COEFF(name, member) \

@@ -20,7 +20,7 @@
 #include "dynamics/kinematic_bicycle.hpp"
 #include "dynamics/single_track.hpp"
 #include "factory/make_controller.hpp"
-#include "kernels/vulkan_backend.hpp"
+#include "vulkan/vulkan_backend.hpp"
 #include "mppi/controller.hpp"
 #include "vulkan/vulkan_test_util.hpp"
 

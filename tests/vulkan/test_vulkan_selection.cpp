@@ -10,7 +10,7 @@
 #include "costs/autorally_cost.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
 #include "factory/make_controller.hpp"
-#include "kernels/vulkan_backend.hpp"
+#include "vulkan/vulkan_backend.hpp"
 #include "tests/mppi/linear_system.hpp"
 #include "vulkan/vulkan_test_util.hpp"
 

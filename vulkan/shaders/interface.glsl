@@ -1,4 +1,4 @@
-// The descriptor set every shader of the backend sees (kernels/vulkan_backend.cpp fills it).
+// The descriptor set every shader of the backend sees (vulkan/vulkan_backend.cpp fills it).
 #ifndef MPPI_INTERFACE_GLSL
 #define MPPI_INTERFACE_GLSL
 

@@ -1,5 +1,5 @@
 // The rollout shader, part 1 (before the model): shader constants, the descriptor set, NU.
-// The build writes one rollout_<model>.comp per kernels/shaders/models/<model>.glsl:
+// The build writes one rollout_<model>.comp per vulkan/shaders/models/<model>.glsl:
 //   rollout_head.glsl, layout_<model>.glsl (generated), models/<model>.glsl, rollout_body.glsl.
 // One invocation = one sample k: draws its perturbed controls with Philox (kGenerate) or reads
 // them (kGenerate = false), steps the model over the horizon and sums the AutoRally running

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "kernels/vulkan_api.hpp"
-#include "kernels/vulkan_backend.hpp"
+#include "vulkan/vulkan_api.hpp"
+#include "vulkan/vulkan_backend.hpp"
 
 namespace mppi::vulkan {
 namespace detail {

@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "kernels/vulkan_backend.hpp"
+#include "vulkan/vulkan_backend.hpp"
 #include "factory/backend_registry.hpp"
 #include "base/error.hpp"
 

@@ -1,7 +1,7 @@
 #pragma once
 // The Vulkan compute backend: the same MPPI as the CPU backend on any Vulkan 1.1 device.
-// GLSL shaders in kernels/shaders/ (compiled to SPIR-V at build time) roll out any model whose
-// descriptor declares a GPU twin (kernels/shaders/models/<kernel>.glsl) under the AutoRally cost,
+// GLSL shaders in vulkan/shaders/ (compiled to SPIR-V at build time) roll out any model whose
+// descriptor declares a GPU twin (vulkan/shaders/models/<kernel>.glsl) under the AutoRally cost,
 // draw the Philox noise on the device and form the weighted update there. Buffers are
 // allocated once per (K, T), descriptor sets written once, two command buffers recorded once
 // and replayed; per step only a small uniform buffer and the T x nu plan are written.

@@ -1,5 +1,5 @@
 // The Vulkan backend: device set-up, buffers, pipelines and the two recorded command buffers.
-#include "kernels/vulkan_backend.hpp"
+#include "vulkan/vulkan_backend.hpp"
 
 #include <stdint.h>
 
@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "kernels/vulkan_api.hpp"
+#include "vulkan/vulkan_api.hpp"
 #include "mppi/cpu_backend.hpp"
 #include "base/error.hpp"
 
-// SPIR-V made at build time by glslangValidator (kernels/CMakeLists.txt), checked by spirv-val.
+// SPIR-V made at build time by glslangValidator (vulkan/CMakeLists.txt), checked by spirv-val.
 #include "costs/autorally_cost_gpu.hpp"
 #include "reduce.spv.h"
 #include "rollout_kernels.hpp"
