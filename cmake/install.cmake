@@ -6,7 +6,7 @@ foreach(folder IN ITEMS base mppi dynamics costs factory sim chassis plot)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${folder}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/${folder}
           FILES_MATCHING PATTERN "*.hpp")
 endforeach()
-install(FILES ${MPPI_GENERATED_DIR}/mppi/model_list.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/mppi)
+install(FILES ${MPPI_GENERATED_DIR}/dynamics/model_list.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/dynamics)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/data/ DESTINATION ${CMAKE_INSTALL_DATADIR}/mppi/data)
 
 install(TARGETS mppi_core mppi_io mppi_plot mppi_sim mppi_chassis mppi_warnings EXPORT mppiTargets

@@ -17,7 +17,8 @@
 //   static bool gpu_tail(const Model&, GpuTail& tail, std::string* why);   (optional: arrays
 //                                                   after the named floats, shader constants)
 // The line MPPI_REGISTER_MODEL(Descriptor) in the header enters it into the compile-time list of
-// models (mppi/generated/model_list.hpp, collected by the build from dynamics/models/*.hpp).
+// models (<build>/generated/dynamics/model_list.hpp, collected by the build from
+// dynamics/models/*.hpp).
 #include <concepts>
 #include <string>
 #include <string_view>

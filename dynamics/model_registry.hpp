@@ -11,7 +11,7 @@
 
 #include "dynamics/model_descriptor.hpp"
 #include "base/error.hpp"
-#include "mppi/model_list.hpp"  // generated: RegisteredModels
+#include "dynamics/model_list.hpp"  // generated: RegisteredModels
 
 namespace mppi {
 
