@@ -25,9 +25,9 @@
 #include "mppi_fit_commands.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/recording.hpp"
-#include "sysid/diagnose/diagnose.hpp"
-#include "sysid/diagnose/sweep.hpp"
-#include "sysid/diagnose/synth.hpp"
+#include "diagnose/diagnose.hpp"
+#include "diagnose/sweep.hpp"
+#include "diagnose/synth.hpp"
 
 namespace {
 

@@ -8,7 +8,7 @@ inline float clampf(float v, float lo, float hi) noexcept { return std::min(std:
 
 // tanh as an odd [13/6] rational minimax approximant on a clamped argument (beyond
 // |x| = 7.905 tanh rounds to +-1 in float). Max abs error 3.5e-7 over the real line,
-// checked against std::tanh in tests/mppi/test_fast_math.cpp.
+// checked against std::tanh in tests/base/test_fast_math.cpp.
 inline float fast_tanh(float x) noexcept {
   x = clampf(x, -7.90531110763549805f, 7.90531110763549805f);
   const float x2 = x * x;
@@ -30,7 +30,7 @@ inline float fast_tanh(float x) noexcept {
 // The same function with fewer operations, for the network kernels (dynamics/mlp.hpp,
 // dynamics/mlp_avx512_kernels.hpp): x P(x^2) / Q(x^2), an odd [9/6] minimax rational (Q
 // monic), same clamp: 8 multiplies or FMAs, one add and a division against 11 and one. Max abs
-// error 4.5e-7 (tests/mppi/test_fast_math.cpp). fast_tanh stays as it is: the GPU shaders
+// error 4.5e-7 (tests/base/test_fast_math.cpp). fast_tanh stays as it is: the GPU shaders
 // (vulkan/shaders/common.glsl) repeat its operations for CPU/GPU parity.
 inline constexpr float kTanhClamp = 7.90531110763549805f;
 inline constexpr float kTanhP[5] = {5091.705421197275f, 647.0683863962777f, 13.712402210685147f,
@@ -47,7 +47,7 @@ inline float fast_tanh96(float x) noexcept {
 // A cheaper tanh for the reduced-precision (bf16) network path, whose activations are rounded
 // to bf16 (relative error up to 2^-9 = 2e-3) right after it: x P(x^2) / Q(x^2), an odd [5/4]
 // minimax rational (Q monic), argument clamped to +-5. Max abs error 4.8e-5 over the real line
-// (tests/mppi/test_fast_math.cpp), 40x below the bf16 rounding that follows it. 5 multiplies or
+// (tests/base/test_fast_math.cpp), 40x below the bf16 rounding that follows it. 5 multiplies or
 // FMAs, one add and a division, against 8, one and one for fast_tanh96.
 inline constexpr float kTanhLowpClamp = 5.0f;
 inline constexpr float kTanhLowpP[3] = {79.1047588133683f, 8.048281203772188f, 0.05181811641204074f};
