@@ -29,7 +29,7 @@
 #include "costs/autorally_cost.hpp"
 #include "costs/cost_config.hpp"
 #include "mppi/cost_map.hpp"
-#include "dynamics/models/single_track.hpp"
+#include "dynamics/models/single_track_model.hpp"
 #include "mppi/controller.hpp"
 #include "base/error.hpp"
 #include "sim/crash_detector.hpp"

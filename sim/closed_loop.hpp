@@ -10,8 +10,8 @@
 #include <utility>
 #include <vector>
 
-#include "dynamics/models/autorally_nn.hpp"
-#include "dynamics/models/single_track.hpp"
+#include "dynamics/models/autorally_nn_model.hpp"
+#include "dynamics/models/single_track_model.hpp"
 #include "mppi/backend_choice.hpp"
 #include "mppi/controller_options.hpp"
 #include "sim/plant.hpp"

@@ -16,7 +16,7 @@
 
 #include "costs/autorally_cost.hpp"
 #include "mppi/cost_map.hpp"
-#include "dynamics/models/autorally_bf.hpp"
+#include "dynamics/models/autorally_bf_model.hpp"
 #include "base/npz.hpp"
 #include "factory/make_controller.hpp"
 #include "sim/closed_loop.hpp"

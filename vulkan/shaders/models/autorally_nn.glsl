@@ -1,6 +1,6 @@
 // The AutoRally network (dynamics/autorally_nn.hpp): a 6-H1-H2-4 MLP, tanh, tanh, linear, in
 // the library's conventions; explicit Euler. NX and P_MODEL_TAIL come from the generated
-// layout_autorally_nn.glsl (dynamics/models/autorally_nn.hpp). Parameters from P_MODEL_TAIL,
+// layout_autorally_nn.glsl (dynamics/models/autorally_nn_model.hpp). Parameters from P_MODEL_TAIL,
 // each layer as W (rows
 // padded to a multiple of 4 floats) then b (padded to a multiple of 4), so that a row is read
 // 4 weights per uniform load (lavapipe: one load per weight made the net ~4x slower). The

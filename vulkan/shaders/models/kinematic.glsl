@@ -1,5 +1,5 @@
 // The kinematic bicycle (dynamics/kinematic_bicycle.hpp). Its parameters (K_*) and NX are
-// defined by the generated layout_kinematic.glsl from dynamics/models/kinematic.hpp.
+// defined by the generated layout_kinematic.glsl from dynamics/models/kinematic_model.hpp.
 void model_step(inout float x[NX], float steer, float throttle, float dt) {
   precise float inv_l = K_INV_WHEELBASE, max_steer = K_MAX_STEER;
   precise float a_max = K_MAX_ACCEL, damping = K_DAMPING;

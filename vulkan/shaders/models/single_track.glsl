@@ -1,6 +1,6 @@
 // The single-track model with Pacejka tyres (dynamics/single_track.hpp, dynamics/pacejka.hpp),
 // float, the same fast math. Its parameters (K_*, SingleTrackCoeffs<float>) and NX are defined
-// by the generated layout_single_track.glsl from dynamics/models/single_track.hpp.
+// by the generated layout_single_track.glsl from dynamics/models/single_track_model.hpp.
 
 float maxf(float a, float b) { return (a < b) ? b : a; }  // std::max
 float minf(float a, float b) { return (b < a) ? b : a; }  // std::min
