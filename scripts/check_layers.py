@@ -277,14 +277,14 @@ def self_test():
                                'namespace mppi {\nstruct Arbiter {};\n}\n'  # wrong namespace
                                'namespace mppi { class Controller; namespace plot { class Figure; } }\n',
         'dynamics/effects.hpp': '#pragma once\nnamespace mppi {\n}\n',
-        'diagnose/effects.hpp': '#pragma once\nnamespace mppi { namespace diagnose {\n} }\n',  # doubled name
+        'evidence/effects.hpp': '#pragma once\nnamespace mppi { namespace evidence {\n} }\n',  # doubled name
         # these are fine and must not be reported
         'costs/cost.hpp': '#pragma once\n#include "base/error.hpp"\nnamespace YAML { class Node; }\n'
                           'namespace mppi {\nnamespace detail {\n}\nnamespace {\n}\n}\n'
                           'const char* s = R"x(namespace wrong { )x";\n',
         'plot/figure.cpp': '#include "base/error.hpp"\nnamespace {\nint f() { return 0; }\n}\n'
                            'namespace mppi::plot::detail {\n}\n',
-        'apps/main.cpp': '#include "diagnose/effects.hpp"\n#include "sim/track.hpp"\nnamespace app {\n}\n',
+        'apps/main.cpp': '#include "evidence/effects.hpp"\n#include "sim/track.hpp"\nnamespace app {\n}\n',
     }
     expected = {
         'upward include': lambda p: 'mppi/controller.hpp:3' in p and 'above mppi/' in p,
