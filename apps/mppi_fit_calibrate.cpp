@@ -12,17 +12,17 @@
 #include <string>
 #include <vector>
 
+#include "base/error.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/corrected_model.hpp"
 #include "dynamics/effects.hpp"
 #include "dynamics/model_registry.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "base/error.hpp"
 #include "mppi/vehicle_state.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"
-#include "sysid/plant_calibration.hpp"
 #include "sysid/manoeuvre_rollout.hpp"
+#include "sysid/plant_calibration.hpp"
 #include "sysid/vehicle_estimation.hpp"
 
 namespace {

@@ -23,11 +23,11 @@
 #include "base/error.hpp"
 #include "dynamics/model_registry.hpp"
 #include "mppi_fit_commands.hpp"
-#include "sim/closed_loop.hpp"
-#include "sim/recording.hpp"
 #include "diagnose/diagnose.hpp"
 #include "diagnose/sweep.hpp"
 #include "diagnose/synth.hpp"
+#include "sim/closed_loop.hpp"
+#include "sim/recording.hpp"
 
 namespace {
 

@@ -23,15 +23,15 @@
 
 #include <nlohmann/json.hpp>
 
+#include "base/error.hpp"
 #include "chassis/chassis.hpp"
 #include "chassis/control_loop.hpp"
 #include "chassis/udp_adapter.hpp"
 #include "costs/autorally_cost.hpp"
 #include "costs/cost_config.hpp"
-#include "mppi/cost_map.hpp"
 #include "dynamics/models/single_track_model.hpp"
 #include "mppi/controller.hpp"
-#include "base/error.hpp"
+#include "mppi/cost_map.hpp"
 #include "sim/crash_detector.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/geometry.hpp"

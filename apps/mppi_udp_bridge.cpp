@@ -10,13 +10,13 @@
 #include <string>
 #include <thread>
 
+#include "base/error.hpp"
 #include "chassis/chassis.hpp"
 #include "chassis/udp_adapter.hpp"
 #include "cli/app.hpp"
 #include "cli/options.hpp"
 #include "dynamics/single_track.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "base/error.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/lap_counter.hpp"
 #include "sim/plant.hpp"

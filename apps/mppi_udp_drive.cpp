@@ -13,18 +13,18 @@
 #include <thread>
 #include <vector>
 
+#include "base/error.hpp"
 #include "chassis/control_loop.hpp"
 #include "chassis/udp_adapter.hpp"
 #include "cli/app.hpp"
 #include "cli/options.hpp"
 #include "costs/autorally_cost.hpp"
 #include "costs/cost_config.hpp"
-#include "mppi/cost_map.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
 #include "dynamics/model_registry.hpp"
 #include "mppi/controller.hpp"
-#include "base/error.hpp"
+#include "mppi/cost_map.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/lap_counter.hpp"
 #include "sim/track.hpp"

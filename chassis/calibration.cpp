@@ -4,8 +4,8 @@
 #include <cmath>
 #include <map>
 
-#include "chassis/yaml_util.hpp"
 #include "base/error.hpp"
+#include "chassis/yaml_util.hpp"
 
 namespace mppi::chassis {
 

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <set>
 
-#include "chassis/yaml_util.hpp"
 #include "base/error.hpp"
+#include "chassis/yaml_util.hpp"
 
 namespace mppi::chassis {
 

@@ -16,10 +16,10 @@
 #include <opencv2/imgcodecs.hpp>
 #pragma GCC diagnostic pop
 
-#include "mppi/cost_map.hpp"
-#include "costs/python_dict_text.hpp"
-#include "base/npz.hpp"
 #include "base/error.hpp"
+#include "base/npz.hpp"
+#include "costs/python_dict_text.hpp"
+#include "mppi/cost_map.hpp"
 
 namespace mppi {
 

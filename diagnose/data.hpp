@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "sim/recording.hpp"
 #include "diagnose/screen.hpp"
+#include "sim/recording.hpp"
 
 namespace mppi::diagnose {
 

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "diagnose/data.hpp"
 #include "diagnose/candidate_effects.hpp"
+#include "diagnose/data.hpp"
 #include "diagnose/model_family.hpp"
 #include "diagnose/replay.hpp"
 

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "diagnose/data.hpp"
 #include "diagnose/candidate_effects.hpp"
+#include "diagnose/data.hpp"
 
 namespace mppi::diagnose {
 

@@ -5,10 +5,10 @@
 #include <string>
 #include <vector>
 
-#include "plot/figure.hpp"
 #include "diagnose/data.hpp"
 #include "diagnose/locate.hpp"
 #include "diagnose/replay.hpp"
+#include "plot/figure.hpp"
 
 namespace mppi::diagnose {
 

@@ -13,9 +13,9 @@
 #include <cstddef>
 #include <string>
 
-#include "dynamics/fast_trig.hpp"
 #include "base/batch.hpp"
 #include "base/error.hpp"
+#include "dynamics/fast_trig.hpp"
 
 namespace mppi {
 

@@ -81,9 +81,9 @@
 #include <string>
 #include <vector>
 
-#include "dynamics/vehicle_params.hpp"
 #include "base/error.hpp"
 #include "base/param_table.hpp"
+#include "dynamics/vehicle_params.hpp"
 
 namespace mppi {
 

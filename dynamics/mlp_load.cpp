@@ -2,9 +2,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "dynamics/mlp.hpp"
-#include "base/npz.hpp"
 #include "base/error.hpp"
+#include "base/npz.hpp"
+#include "dynamics/mlp.hpp"
 
 namespace mppi {
 

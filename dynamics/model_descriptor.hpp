@@ -24,8 +24,8 @@
 #include <string_view>
 #include <vector>
 
-#include "mppi/concepts.hpp"
 #include "base/param_table.hpp"
+#include "mppi/concepts.hpp"
 
 namespace mppi {
 

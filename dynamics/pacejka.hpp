@@ -8,8 +8,8 @@
 #include <cmath>
 #include <string>
 
-#include "dynamics/fast_trig.hpp"
 #include "base/fast_math.hpp"
+#include "dynamics/fast_trig.hpp"
 
 namespace mppi {
 

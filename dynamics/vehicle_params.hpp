@@ -9,8 +9,8 @@
 #include <string_view>
 #include <vector>
 
-#include "dynamics/pacejka.hpp"
 #include "base/param_table.hpp"
+#include "dynamics/pacejka.hpp"
 
 namespace mppi {
 

@@ -4,13 +4,13 @@
 #include <string>
 #include <vector>
 
+#include "base/error.hpp"
+#include "base/param_yaml.hpp"
 #include "dynamics/models/double_track_model.hpp"
 #include "dynamics/models/full_vehicle_model.hpp"
 #include "dynamics/models/kinematic_model.hpp"
 #include "dynamics/models/single_track_model.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "base/error.hpp"
-#include "base/param_yaml.hpp"
 
 namespace mppi {
 

@@ -12,15 +12,15 @@
 #include <nlohmann/json.hpp>
 
 #include "base/error.hpp"
+#include "evidence/actuators.hpp"
+#include "evidence/car_physics.hpp"
+#include "evidence/drivers.hpp"
 #include "sim/crash_detector.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/geometry.hpp"
 #include "sim/recording.hpp"
 #include "sim/surface_map.hpp"
 #include "sim/track.hpp"
-#include "evidence/actuators.hpp"
-#include "evidence/car_physics.hpp"
-#include "evidence/drivers.hpp"
 
 namespace mppi::evidence {
 namespace {

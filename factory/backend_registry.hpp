@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "costs/autorally_cost.hpp"
+#include "factory/gpu_twin.hpp"
 #include "mppi/backend.hpp"
 #include "mppi/backend_choice.hpp"
 #include "mppi/controller_options.hpp"
-#include "factory/gpu_twin.hpp"
 
 namespace mppi {
 

@@ -13,10 +13,10 @@
 #include <type_traits>
 #include <utility>
 
-#include "mppi/backend_choice.hpp"
 #include "factory/backend_registry.hpp"
-#include "mppi/controller.hpp"
 #include "factory/gpu_twin.hpp"
+#include "mppi/backend_choice.hpp"
+#include "mppi/controller.hpp"
 
 namespace mppi {
 

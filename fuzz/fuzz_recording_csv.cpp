@@ -2,9 +2,9 @@
 // (diagnose/data.cpp: columns, pieces, sample interval).
 #include <sstream>
 
+#include "diagnose/data.hpp"
 #include "fuzz/fuzz_input.hpp"
 #include "sim/recording.hpp"
-#include "diagnose/data.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   mppi::fuzz::expect_value_or_error([&] {

@@ -17,11 +17,11 @@
 #include <immintrin.h>
 #endif
 
-#include "mppi/backend.hpp"
 #include "base/batch.hpp"
-#include "mppi/concepts.hpp"
 #include "base/error.hpp"
 #include "base/multiversion.hpp"
+#include "mppi/backend.hpp"
+#include "mppi/concepts.hpp"
 #include "mppi/noise.hpp"
 #include "mppi/sample_step.hpp"
 #include "mppi/thread_schedule.hpp"

@@ -9,8 +9,8 @@
 #include <string>
 #include <utility>
 
-#include "mppi/backend.hpp"
 #include "base/error.hpp"
+#include "mppi/backend.hpp"
 
 namespace mppi {
 

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "base/batch.hpp"
-#include "mppi/concepts.hpp"
 #include "base/error.hpp"
+#include "mppi/concepts.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi::sim {

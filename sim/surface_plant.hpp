@@ -8,8 +8,8 @@
 #include <map>
 #include <memory>
 
-#include "dynamics/single_track.hpp"
 #include "base/batch.hpp"
+#include "dynamics/single_track.hpp"
 #include "sim/surface_map.hpp"
 
 namespace mppi::sim {

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "vulkan/vulkan_api.hpp"
-#include "mppi/cpu_backend.hpp"
 #include "base/error.hpp"
+#include "mppi/cpu_backend.hpp"
+#include "vulkan/vulkan_api.hpp"
 
 // SPIR-V made at build time by glslangValidator (vulkan/CMakeLists.txt), checked by spirv-val.
 #include "costs/autorally_cost_gpu.hpp"

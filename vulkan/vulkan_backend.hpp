@@ -16,8 +16,8 @@
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
 #include "dynamics/single_track.hpp"
-#include "mppi/backend.hpp"
 #include "factory/gpu_twin.hpp"
+#include "mppi/backend.hpp"
 
 namespace mppi::vulkan {
 

@@ -5,9 +5,9 @@
 #include <memory>
 #include <string>
 
-#include "vulkan/vulkan_backend.hpp"
-#include "factory/backend_registry.hpp"
 #include "base/error.hpp"
+#include "factory/backend_registry.hpp"
+#include "vulkan/vulkan_backend.hpp"
 
 namespace mppi::vulkan {
 namespace {

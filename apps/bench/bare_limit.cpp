@@ -6,12 +6,12 @@
 #include <cmath>
 #include <cstring>
 
-#include "dynamics/mlp.hpp"
-#include "base/npz.hpp"
 #include "base/batch.hpp"
 #include "base/error.hpp"
 #include "base/fast_math.hpp"
 #include "base/multiversion.hpp"
+#include "base/npz.hpp"
+#include "dynamics/mlp.hpp"
 
 namespace mppi::bench {
 

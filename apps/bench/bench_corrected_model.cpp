@@ -11,9 +11,9 @@
 #include <random>
 #include <vector>
 
-#include "dynamics/with_effects.hpp"
 #include "base/batch.hpp"
 #include "base/multiversion.hpp"
+#include "dynamics/with_effects.hpp"
 
 namespace {
 

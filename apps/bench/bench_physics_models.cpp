@@ -7,11 +7,11 @@
 #include <random>
 #include <vector>
 
+#include "base/batch.hpp"
+#include "base/multiversion.hpp"
 #include "dynamics/double_track.hpp"
 #include "dynamics/full_vehicle.hpp"
 #include "dynamics/single_track.hpp"
-#include "base/batch.hpp"
-#include "base/multiversion.hpp"
 
 namespace {
 

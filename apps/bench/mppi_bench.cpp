@@ -43,9 +43,9 @@
 #include "bare_limit.hpp"
 #include "parts.hpp"
 #include "costs/autorally_cost.hpp"
-#include "mppi/cost_map.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "mppi/controller.hpp"
+#include "mppi/cost_map.hpp"
 #include "mppi/cpu_backend.hpp"
 #include "mppi/noise.hpp"
 

@@ -26,11 +26,11 @@
 #include <string>
 #include <vector>
 
+#include "base/multiversion.hpp"
 #include "costs/autorally_cost.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "mppi/controller.hpp"
 #include "mppi/cpu_backend.hpp"
-#include "base/multiversion.hpp"
 #include "mppi/noise.hpp"
 #include "peer_workload.hpp"
 

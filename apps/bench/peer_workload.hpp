@@ -10,10 +10,10 @@
 #include <memory>
 #include <vector>
 
-#include "mppi/cost_map.hpp"
 #include "costs/goal_obstacle_cost.hpp"
 #include "dynamics/diff_drive.hpp"
 #include "mppi/controller_options.hpp"
+#include "mppi/cost_map.hpp"
 
 namespace mppi::bench {
 

@@ -4,9 +4,9 @@
 #include <string>
 #include <vector>
 
+#include "base/error.hpp"
 #include "dynamics/autorally_bf.hpp"
 #include "dynamics/model_descriptor.hpp"
-#include "base/error.hpp"
 
 namespace mppi::models {
 

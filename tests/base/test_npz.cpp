@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "base/npz.hpp"
 #include "base/error.hpp"
+#include "base/npz.hpp"
 #include "test_data.hpp"
 
 namespace {

@@ -7,9 +7,9 @@
 #include <filesystem>
 #include <string>
 
+#include "diagnose/candidate_effects.hpp"
 #include "diagnose/data.hpp"
 #include "diagnose/diagnose.hpp"
-#include "diagnose/candidate_effects.hpp"
 #include "diagnose/joint_refit.hpp"
 #include "diagnose/model_family.hpp"
 #include "diagnose/synth.hpp"

@@ -8,9 +8,9 @@
 #include <filesystem>
 
 #include "base/error.hpp"
+#include "diagnose/synth.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/recording.hpp"
-#include "diagnose/synth.hpp"
 
 using namespace mppi;
 

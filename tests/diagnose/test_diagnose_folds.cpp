@@ -8,10 +8,10 @@
 #include <deque>
 #include <random>
 
-#include "dynamics/single_track.hpp"
 #include "diagnose/diagnose.hpp"
 #include "diagnose/replay.hpp"
 #include "diagnose/synth.hpp"
+#include "dynamics/single_track.hpp"
 
 using namespace mppi;
 using namespace mppi::diagnose;

@@ -9,11 +9,11 @@
 #include <filesystem>
 #include <fstream>
 
-#include "dynamics/with_effects.hpp"
 #include "base/error.hpp"
 #include "diagnose/diagnose.hpp"
 #include "diagnose/model_family.hpp"
 #include "diagnose/synth.hpp"
+#include "dynamics/with_effects.hpp"
 #include "diagnose_fixtures.hpp"
 
 using namespace mppi;

@@ -7,10 +7,10 @@
 #include <random>
 #include <vector>
 
-#include "dynamics/autorally_nn.hpp"
-#include "base/npz.hpp"
-#include "mppi/concepts.hpp"
 #include "base/error.hpp"
+#include "base/npz.hpp"
+#include "dynamics/autorally_nn.hpp"
+#include "mppi/concepts.hpp"
 #include "test_data.hpp"
 
 static_assert(mppi::Dynamics<mppi::AutoRallyNetwork>);

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "dynamics/autorally_nn.hpp"
 #include "base/batch.hpp"
+#include "dynamics/autorally_nn.hpp"
 #include "test_data.hpp"
 
 namespace {

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "dynamics/mlp.hpp"
-#include "base/npz.hpp"
 #include "base/error.hpp"
+#include "base/npz.hpp"
+#include "dynamics/mlp.hpp"
 #include "test_data.hpp"
 
 namespace {

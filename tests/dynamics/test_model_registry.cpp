@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "dynamics/model_registry.hpp"
-#include "dynamics/vehicle_params.hpp"
 #include "base/error.hpp"
 #include "base/param_yaml.hpp"
+#include "dynamics/model_registry.hpp"
+#include "dynamics/vehicle_params.hpp"
 #include "test_data.hpp"
 
 namespace {

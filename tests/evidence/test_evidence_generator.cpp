@@ -12,16 +12,16 @@
 #include <random>
 #include <sstream>
 
-#include "dynamics/vehicle_params.hpp"
 #include "base/error.hpp"
-#include "sim/data_dir.hpp"
-#include "sim/recording.hpp"
 #include "diagnose/data.hpp"
 #include "diagnose/model_family.hpp"
 #include "diagnose/replay.hpp"
+#include "dynamics/vehicle_params.hpp"
 #include "evidence/actuators.hpp"
 #include "evidence/car_physics.hpp"
 #include "evidence/generator.hpp"
+#include "sim/data_dir.hpp"
+#include "sim/recording.hpp"
 #include "test_data.hpp"
 
 using namespace mppi;

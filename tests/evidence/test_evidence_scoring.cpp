@@ -13,9 +13,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "sim/recording.hpp"
 #include "diagnose/evidence_sweep.hpp"
 #include "evidence/generator.hpp"
+#include "sim/recording.hpp"
 
 using namespace mppi;
 

@@ -3,8 +3,8 @@
 // plant as it was.
 #include <catch2/catch.hpp>
 
-#include "dynamics/kinematic_bicycle.hpp"
 #include "base/error.hpp"
+#include "dynamics/kinematic_bicycle.hpp"
 #include "sim/plant.hpp"
 
 using namespace mppi;

@@ -18,8 +18,8 @@
 #include "dynamics/vehicle_params.hpp"
 #include "error_of.hpp"
 #include "mppi/vehicle_state.hpp"
-#include "sysid/plant_calibration.hpp"
 #include "sysid/manoeuvre_rollout.hpp"
+#include "sysid/plant_calibration.hpp"
 #include "sysid/vehicle_estimation.hpp"
 #include "test_data.hpp"
 
