@@ -16,53 +16,40 @@ inline void keep(V& v) {
   asm volatile("" : "+v"(v));  // the chains stay in registers and are not folded together
 }
 
-__attribute__((target("avx2,fma"))) void fma_chains_256(benchmark::State& state) {
-  // Twelve named registers, not an array: an array's chains go through memory.
-  __m256 a0 = _mm256_set1_ps(1), a1 = _mm256_set1_ps(2), a2 = _mm256_set1_ps(3), a3 = _mm256_set1_ps(4),
-         a4 = _mm256_set1_ps(5), a5 = _mm256_set1_ps(6), a6 = _mm256_set1_ps(7), a7 = _mm256_set1_ps(8),
-         a8 = _mm256_set1_ps(9), a9 = _mm256_set1_ps(10), a10 = _mm256_set1_ps(11), a11 = _mm256_set1_ps(12);
-  const __m256 m = _mm256_set1_ps(0.999999f), c = _mm256_set1_ps(1e-7f);
-  for (auto _ : state) {
-    for (long r = 0; r < kRoundsPerIteration; ++r) {
-#define MPPI_FMA(v) v = _mm256_fmadd_ps(v, m, c)
-      MPPI_FMA(a0); MPPI_FMA(a1); MPPI_FMA(a2); MPPI_FMA(a3); MPPI_FMA(a4); MPPI_FMA(a5);
-      MPPI_FMA(a6); MPPI_FMA(a7); MPPI_FMA(a8); MPPI_FMA(a9); MPPI_FMA(a10); MPPI_FMA(a11);
-#undef MPPI_FMA
-      keep(a0), keep(a1), keep(a2), keep(a3), keep(a4), keep(a5);
-      keep(a6), keep(a7), keep(a8), keep(a9), keep(a10), keep(a11);
-    }
+// One benchmark body for both widths. GCC inlines an AVX intrinsic only into a function compiled
+// for its target, so a template without the attribute cannot hold the body: this macro stamps
+// out the whole function, attribute included. VEC: the vector type, P: the intrinsics' prefix
+// (_mm256 or _mm512), LANES: floats per vector.
+#define MPPI_FMA(P, v) v = P##_fmadd_ps(v, m, c)
+#define MPPI_DEFINE_FMA_CHAINS(NAME, TARGET, VEC, P, LANES)                                          \
+  __attribute__((target(TARGET))) void NAME(benchmark::State& state) {                               \
+    /* Twelve named registers, not an array: an array's chains go through memory. */                \
+    VEC a0 = P##_set1_ps(1), a1 = P##_set1_ps(2), a2 = P##_set1_ps(3), a3 = P##_set1_ps(4),           \
+        a4 = P##_set1_ps(5), a5 = P##_set1_ps(6), a6 = P##_set1_ps(7), a7 = P##_set1_ps(8),           \
+        a8 = P##_set1_ps(9), a9 = P##_set1_ps(10), a10 = P##_set1_ps(11), a11 = P##_set1_ps(12);      \
+    const VEC m = P##_set1_ps(0.999999f), c = P##_set1_ps(1e-7f);                                    \
+    for (auto _ : state) {                                                                           \
+      for (long r = 0; r < kRoundsPerIteration; ++r) {                                               \
+        MPPI_FMA(P, a0); MPPI_FMA(P, a1); MPPI_FMA(P, a2); MPPI_FMA(P, a3);                          \
+        MPPI_FMA(P, a4); MPPI_FMA(P, a5); MPPI_FMA(P, a6); MPPI_FMA(P, a7);                          \
+        MPPI_FMA(P, a8); MPPI_FMA(P, a9); MPPI_FMA(P, a10); MPPI_FMA(P, a11);                        \
+        keep(a0), keep(a1), keep(a2), keep(a3), keep(a4), keep(a5);                                  \
+        keep(a6), keep(a7), keep(a8), keep(a9), keep(a10), keep(a11);                                \
+      }                                                                                              \
+    }                                                                                                \
+    float sink[LANES];                                                                               \
+    P##_storeu_ps(sink, P##_add_ps(a0, a11));                                                        \
+    benchmark::DoNotOptimize(sink[0]);                                                               \
+    const double fmas = static_cast<double>(state.iterations()) * kRoundsPerIteration * kChains;     \
+    state.SetItemsProcessed(static_cast<int64_t>(fmas));                                             \
+    state.counters["GFLOPs"] =                                                                       \
+        benchmark::Counter(fmas * 2 * LANES, benchmark::Counter::kIsRate, benchmark::Counter::kIs1000); \
   }
-  float sink[8];
-  _mm256_storeu_ps(sink, _mm256_add_ps(a0, a11));
-  benchmark::DoNotOptimize(sink[0]);
-  const double fmas = static_cast<double>(state.iterations()) * kRoundsPerIteration * kChains;
-  state.SetItemsProcessed(static_cast<int64_t>(fmas));
-  state.counters["GFLOPs"] = benchmark::Counter(fmas * 2 * 8, benchmark::Counter::kIsRate, benchmark::Counter::kIs1000);
-}
 
-__attribute__((target("avx512f"))) void fma_chains_512(benchmark::State& state) {
-  // Twelve named registers, not an array: an array's chains go through memory.
-  __m512 a0 = _mm512_set1_ps(1), a1 = _mm512_set1_ps(2), a2 = _mm512_set1_ps(3), a3 = _mm512_set1_ps(4),
-         a4 = _mm512_set1_ps(5), a5 = _mm512_set1_ps(6), a6 = _mm512_set1_ps(7), a7 = _mm512_set1_ps(8),
-         a8 = _mm512_set1_ps(9), a9 = _mm512_set1_ps(10), a10 = _mm512_set1_ps(11), a11 = _mm512_set1_ps(12);
-  const __m512 m = _mm512_set1_ps(0.999999f), c = _mm512_set1_ps(1e-7f);
-  for (auto _ : state) {
-    for (long r = 0; r < kRoundsPerIteration; ++r) {
-#define MPPI_FMA(v) v = _mm512_fmadd_ps(v, m, c)
-      MPPI_FMA(a0); MPPI_FMA(a1); MPPI_FMA(a2); MPPI_FMA(a3); MPPI_FMA(a4); MPPI_FMA(a5);
-      MPPI_FMA(a6); MPPI_FMA(a7); MPPI_FMA(a8); MPPI_FMA(a9); MPPI_FMA(a10); MPPI_FMA(a11);
+MPPI_DEFINE_FMA_CHAINS(fma_chains_256, "avx2,fma", __m256, _mm256, 8)
+MPPI_DEFINE_FMA_CHAINS(fma_chains_512, "avx512f", __m512, _mm512, 16)
+#undef MPPI_DEFINE_FMA_CHAINS
 #undef MPPI_FMA
-      keep(a0), keep(a1), keep(a2), keep(a3), keep(a4), keep(a5);
-      keep(a6), keep(a7), keep(a8), keep(a9), keep(a10), keep(a11);
-    }
-  }
-  float sink[16];
-  _mm512_storeu_ps(sink, _mm512_add_ps(a0, a11));
-  benchmark::DoNotOptimize(sink[0]);
-  const double fmas = static_cast<double>(state.iterations()) * kRoundsPerIteration * kChains;
-  state.SetItemsProcessed(static_cast<int64_t>(fmas));
-  state.counters["GFLOPs"] = benchmark::Counter(fmas * 2 * 16, benchmark::Counter::kIsRate, benchmark::Counter::kIs1000);
-}
 
 void BM_FmaPeak256(benchmark::State& state) {
   if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma")) {
