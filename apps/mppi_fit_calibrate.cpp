@@ -2,7 +2,7 @@
 // to a learned dynamics model (the AutoRally network) treated as the recording of the real car:
 // the network is driven open loop through the paper's five manoeuvres (training and held-out
 // command sequences from different seeds), and the plant's parameters are chosen to minimise
-// its 1-s open-loop prediction error on the training set (sysid/calibration.hpp). Reports
+// its 1-s open-loop prediction error on the training set (sysid/plant_calibration.hpp). Reports
 // the held-out normalised RMSE per channel and lead time before and after. docs/CALIBRATION.md.
 #include <cmath>
 #include <cstdio>
@@ -12,17 +12,17 @@
 #include <string>
 #include <vector>
 
+#include "base/error.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/corrected_model.hpp"
 #include "dynamics/effects.hpp"
 #include "dynamics/model_registry.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/error.hpp"
 #include "mppi/vehicle_state.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"
-#include "sysid/calibration.hpp"
 #include "sysid/manoeuvre_rollout.hpp"
+#include "sysid/plant_calibration.hpp"
 #include "sysid/vehicle_estimation.hpp"
 
 namespace {

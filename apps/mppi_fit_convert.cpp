@@ -4,9 +4,9 @@
 #include <memory>
 #include <string>
 
+#include "base/error.hpp"
 #include "cli/app.hpp"
 #include "cli/options.hpp"
-#include "mppi/error.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"
 #include "sysid/real_data.hpp"

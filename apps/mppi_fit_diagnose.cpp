@@ -20,14 +20,14 @@
 #include "cli/options.hpp"
 #include "dynamics/corrected_model.hpp"
 #include "dynamics/effects.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "dynamics/model_registry.hpp"
 #include "mppi_fit_commands.hpp"
+#include "diagnose/diagnose.hpp"
+#include "diagnose/sweep.hpp"
+#include "diagnose/synth.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/recording.hpp"
-#include "sysid/diagnose/diagnose.hpp"
-#include "sysid/diagnose/sweep.hpp"
-#include "sysid/diagnose/synth.hpp"
 
 namespace {
 

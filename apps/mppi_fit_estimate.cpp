@@ -16,7 +16,7 @@
 #include "cli/options.hpp"
 #include "dynamics/vehicle_params.hpp"
 #include "dynamics/model_registry.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"
 #include "sysid/estimation_plots.hpp"

@@ -1,5 +1,5 @@
 // mppi-fit diagnose synth|sweep --generator independent: recordings of the independent evidence
-// generator (sysid/evidence, docs/EVIDENCE.md) and the diagnosis judged on them.
+// generator (evidence/, docs/EVIDENCE.md) and the diagnosis judged on them.
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
@@ -12,9 +12,9 @@
 #include <thread>
 #include <vector>
 
-#include "mppi/error.hpp"
-#include "sysid/diagnose/evidence_sweep.hpp"
-#include "sysid/evidence/generator.hpp"
+#include "base/error.hpp"
+#include "diagnose/evidence_sweep.hpp"
+#include "evidence/generator.hpp"
 
 namespace {
 
@@ -36,7 +36,7 @@ const char* kEvidenceUsage = R"(usage:
         [--resume]  (keep the runs DIR/runs.jsonl already has, run the rest; same options as before)
         (full grid: 5 seeds, every effect at both sizes, 8 pairs, 20 effect-free; --reduced: 1 seed,
         3 pairs, 4 effect-free). Writes DIR/runs.jsonl, DIR/evidence_sweep.md, DIR/evidence_sweep.json.
-Effects (key=value keys are the fields of sysid/evidence/truth_effects.hpp):
+Effects (key=value keys are the fields of evidence/truth_effects.hpp):
 )";
 
 struct UsageError : std::runtime_error {

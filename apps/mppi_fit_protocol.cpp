@@ -7,7 +7,7 @@
 
 #include "cli/app.hpp"
 #include "cli/options.hpp"
-#include "dynamics/models/full_vehicle.hpp"
+#include "dynamics/models/full_vehicle_model.hpp"
 #include "dynamics/vehicle_params.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"

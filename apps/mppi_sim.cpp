@@ -4,10 +4,10 @@
 #include <iostream>
 #include <string>
 
+#include "base/error.hpp"
 #include "cli/app.hpp"
 #include "cli/sim_command_line.hpp"
 #include "dynamics/model_registry.hpp"
-#include "mppi/error.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/summary.hpp"
 #ifdef MPPI_HAVE_OCS

@@ -18,7 +18,7 @@
 
 #include "costs/autorally_cost.hpp"
 #include "costs/cost_config.hpp"
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "costs/goal_obstacle_cost.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/diff_drive.hpp"
@@ -27,7 +27,7 @@
 #include "dynamics/vehicle_params.hpp"
 #include "dynamics/model_registry.hpp"
 #include "mppi/controller.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/recording.hpp"

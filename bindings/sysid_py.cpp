@@ -1,5 +1,5 @@
-// The sysid tools in the Python module `mppi` (registered from mppi_py.cpp when the library
-// mppi_sysid is built): real-recording conversion, bifilar inertia, the simulated estimation
+// The sysid tools in the Python module `mppi` (registered from mppi_py.cpp when the libraries
+// mppi_sysid and mppi_diagnose are built): real-recording conversion, bifilar inertia, the simulated estimation
 // protocol, ALM-UKF / UKF parameter estimation and validation, and sim-vs-real diagnosis.
 // They mirror the `mppi-fit` sub-commands (apps/mppi_fit_*.cpp) with the same defaults, so
 // the same input gives the same numbers. The GIL is released while C++ computes; mppi::Error
@@ -17,12 +17,12 @@
 
 #include "dynamics/vehicle_params.hpp"
 #include "dynamics/model_registry.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/recording.hpp"
 #include "sysid/bifilar.hpp"
-#include "sysid/diagnose/diagnose.hpp"
-#include "sysid/diagnose/synth.hpp"
+#include "diagnose/diagnose.hpp"
+#include "diagnose/synth.hpp"
 #include "sysid/protocol.hpp"
 #include "sysid/real_data.hpp"
 #include "sysid/vehicle_estimation.hpp"

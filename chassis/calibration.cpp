@@ -4,8 +4,8 @@
 #include <cmath>
 #include <map>
 
+#include "base/error.hpp"
 #include "chassis/yaml_util.hpp"
-#include "mppi/error.hpp"
 
 namespace mppi::chassis {
 

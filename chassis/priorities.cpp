@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <set>
 
+#include "base/error.hpp"
 #include "chassis/yaml_util.hpp"
-#include "mppi/error.hpp"
 
 namespace mppi::chassis {
 

@@ -10,7 +10,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::chassis::udp {
 

@@ -2,7 +2,7 @@
 
 #include <cstring>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::chassis::udp {
 namespace {

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::chassis::detail {
 

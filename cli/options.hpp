@@ -30,7 +30,7 @@ CLI::Option* add_out_option(CLI::App& app, std::string& out, const std::string& 
 // --threads N: CPU threads, 0 = all.
 CLI::Option* add_threads_option(CLI::App& app, int& threads);
 
-// --backend NAME: auto | cpu | vulkan (mppi/make_controller.hpp).
+// --backend NAME: auto | cpu | vulkan (factory/make_controller.hpp).
 CLI::Option* add_backend_option(CLI::App& app, BackendChoice& backend);
 
 // --data-dir DIR: the data folder (sets MPPI_DATA_DIR for this process; sim/data_dir.hpp).

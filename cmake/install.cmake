@@ -2,11 +2,11 @@
 # package so that an out-of-tree project can do find_package(mppi) and link mppi::core etc.
 include(CMakePackageConfigHelpers)
 
-foreach(folder IN ITEMS mppi dynamics costs sim chassis plot)
+foreach(folder IN ITEMS base mppi dynamics costs factory sim chassis plot)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${folder}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/${folder}
           FILES_MATCHING PATTERN "*.hpp")
 endforeach()
-install(FILES ${MPPI_GENERATED_DIR}/mppi/model_list.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/mppi)
+install(FILES ${MPPI_GENERATED_DIR}/dynamics/model_list.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/dynamics)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/data/ DESTINATION ${CMAKE_INSTALL_DATADIR}/mppi/data)
 
 install(TARGETS mppi_core mppi_io mppi_plot mppi_sim mppi_chassis mppi_warnings EXPORT mppiTargets
@@ -23,11 +23,14 @@ install(FILES ${PROJECT_BINARY_DIR}/mppiConfig.cmake ${PROJECT_BINARY_DIR}/mppiC
               ${PROJECT_SOURCE_DIR}/cmake/mppi_installed_data_dir.cpp.in
         DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/mppi)
 
-# The estimation part (sysid/), when built: its headers and library join the package.
-if(TARGET mppi_sysid)
-  install(DIRECTORY ${PROJECT_SOURCE_DIR}/sysid/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/sysid
-          FILES_MATCHING PATTERN "*.hpp")
-  install(TARGETS mppi_sysid EXPORT mppiTargets
-          ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
-          LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
-endif()
+# The estimation part (sysid/), the evidence generator (evidence/) and the sim-vs-real diagnosis
+# (diagnose/), when built: their headers and libraries join the package.
+foreach(part sysid evidence diagnose)
+  if(TARGET mppi_${part})
+    install(DIRECTORY ${PROJECT_SOURCE_DIR}/${part}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mppi/${part}
+            FILES_MATCHING PATTERN "*.hpp")
+    install(TARGETS mppi_${part} EXPORT mppiTargets
+            ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+            LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  endif()
+endforeach()

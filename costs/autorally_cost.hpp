@@ -15,10 +15,10 @@
 #include <utility>
 
 #include "costs/autorally_cost_terms.hpp"
-#include "costs/cost_map.hpp"
-#include "mppi/batch.hpp"
-#include "mppi/param_table.hpp"
-#include "mppi/error.hpp"
+#include "mppi/cost_map.hpp"
+#include "base/batch.hpp"
+#include "base/param_table.hpp"
+#include "base/error.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi {

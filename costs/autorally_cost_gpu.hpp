@@ -1,5 +1,5 @@
 #pragma once
-// The AutoRally cost's GPU twin (kernels/shaders/cost.glsl): the floats at the start of the
+// The AutoRally cost's GPU twin (vulkan/shaders/cost.glsl): the floats at the start of the
 // parameter block, named as the GLSL code reads them. The build generates the GLSL offsets
 // (layout_cost.glsl) from this table and the Vulkan backend packs the block with it, so the
 // two cannot drift apart.

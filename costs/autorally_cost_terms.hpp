@@ -1,17 +1,17 @@
 #pragma once
 // The AutoRally running cost as a sum of terms, each declared once here: its name, the value it
 // adds at one state (its weight is a parameter of AutoRallyCostParams, i.e. data), the field of
-// CostTerms that reports it, and the GLSL function of its GPU twin (kernels/shaders/cost.glsl).
+// CostTerms that reports it, and the GLSL function of its GPU twin (vulkan/shaders/cost.glsl).
 // AutoRallyCost::terms() sums the list in its order on the CPU; the build writes the same sum
 // for the shader (COST_TERMS_SUM in layout_cost.glsl), so both add the terms in one order.
 //
 // A new term: a struct here with kName, kGlsl, kOut and value(), its place in
 // AutoRallyCostTerms, its weight (and any parameter) in AutoRallyCostParams with a row in its
 // parameter table and in gpu_cost_fields() (costs/autorally_cost_gpu.hpp), and its GLSL
-// function in kernels/shaders/cost.glsl reading a CostState.
+// function in vulkan/shaders/cost.glsl reading a CostState.
 #include <algorithm>
 
-#include "mppi/type_list.hpp"
+#include "base/type_list.hpp"
 
 namespace mppi {
 

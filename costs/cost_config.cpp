@@ -2,8 +2,8 @@
 // strict: every mistake is an error with file:line.
 #include "costs/cost_config.hpp"
 
-#include "mppi/error.hpp"
-#include "mppi/param_yaml.hpp"
+#include "base/error.hpp"
+#include "base/param_yaml.hpp"
 
 namespace mppi {
 

@@ -16,10 +16,10 @@
 #include <opencv2/imgcodecs.hpp>
 #pragma GCC diagnostic pop
 
-#include "costs/cost_map.hpp"
+#include "base/error.hpp"
+#include "base/npz.hpp"
 #include "costs/python_dict_text.hpp"
-#include "dynamics/npz.hpp"
-#include "mppi/error.hpp"
+#include "mppi/cost_map.hpp"
 
 namespace mppi {
 

@@ -20,10 +20,10 @@
 #include <utility>
 #include <vector>
 
-#include "costs/cost_map.hpp"
+#include "base/batch.hpp"
+#include "base/error.hpp"
 #include "dynamics/fast_trig.hpp"
-#include "mppi/batch.hpp"
-#include "mppi/error.hpp"
+#include "mppi/cost_map.hpp"
 
 namespace mppi {
 

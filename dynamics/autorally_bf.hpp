@@ -20,10 +20,10 @@
 #include <cstddef>
 #include <string>
 
+#include "base/batch.hpp"
+#include "base/error.hpp"
+#include "base/npz.hpp"
 #include "dynamics/fast_trig.hpp"
-#include "dynamics/npz.hpp"
-#include "mppi/batch.hpp"
-#include "mppi/error.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi {

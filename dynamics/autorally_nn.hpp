@@ -23,9 +23,9 @@
 #include <cstddef>
 #include <string>
 
+#include "base/batch.hpp"
 #include "dynamics/fast_trig.hpp"
 #include "dynamics/mlp.hpp"
-#include "mppi/batch.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi {

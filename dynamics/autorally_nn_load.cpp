@@ -1,9 +1,9 @@
 // AutoRallyNetwork: loading the npz and the one-time conversion to the library's conventions.
 #include <cmath>
 
+#include "base/error.hpp"
+#include "base/npz.hpp"
 #include "dynamics/autorally_nn.hpp"
-#include "dynamics/npz.hpp"
-#include "mppi/error.hpp"
 
 namespace mppi {
 

@@ -7,11 +7,11 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "base/error.hpp"
+#include "base/param_yaml.hpp"
+#include "base/yaml_number.hpp"
 #include "dynamics/corrected_model.hpp"
 #include "dynamics/model_registry.hpp"
-#include "mppi/error.hpp"
-#include "mppi/param_yaml.hpp"
-#include "mppi/yaml_number.hpp"
 
 namespace mppi {
 CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std::string& source) {

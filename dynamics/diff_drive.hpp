@@ -13,9 +13,9 @@
 #include <cstddef>
 #include <string>
 
+#include "base/batch.hpp"
+#include "base/error.hpp"
 #include "dynamics/fast_trig.hpp"
-#include "mppi/batch.hpp"
-#include "mppi/error.hpp"
 
 namespace mppi {
 

@@ -28,12 +28,12 @@
 #include <cstddef>
 #include <string>
 
+#include "base/batch.hpp"
+#include "base/error.hpp"
+#include "base/fast_math.hpp"
 #include "dynamics/fast_trig.hpp"
 #include "dynamics/pacejka.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/batch.hpp"
-#include "mppi/error.hpp"
-#include "mppi/fast_math.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi {

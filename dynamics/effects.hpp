@@ -81,9 +81,9 @@
 #include <string>
 #include <vector>
 
+#include "base/error.hpp"
+#include "base/param_table.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/error.hpp"
-#include "mppi/param_table.hpp"
 
 namespace mppi {
 
@@ -162,7 +162,7 @@ struct EffectParamSpec {
 };
 
 // What a recording must contain for an effect to be identifiable from it (the diagnosis
-// measures it on the data; sysid/diagnose/identifiability.hpp).
+// measures it on the data; diagnose/identifiability.hpp).
 enum class Excitation {
   kAny,         // any driving
   kSteer,       // steering that changes (and turns the car). Also what a steering trim and a

@@ -33,10 +33,10 @@
 #include <cstddef>
 #include <string>
 
+#include "base/batch.hpp"
+#include "base/error.hpp"
 #include "dynamics/double_track.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/batch.hpp"
-#include "mppi/error.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi {

@@ -11,10 +11,10 @@
 #include <cmath>
 #include <cstddef>
 
+#include "base/batch.hpp"
+#include "base/error.hpp"
 #include "dynamics/fast_trig.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/batch.hpp"
-#include "mppi/error.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi {

@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "mppi/batch.hpp"
-#include "mppi/fast_math.hpp"
+#include "base/batch.hpp"
+#include "base/fast_math.hpp"
 
 namespace mppi {
 

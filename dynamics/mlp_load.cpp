@@ -2,9 +2,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "base/error.hpp"
+#include "base/npz.hpp"
 #include "dynamics/mlp.hpp"
-#include "dynamics/npz.hpp"
-#include "mppi/error.hpp"
 
 namespace mppi {
 

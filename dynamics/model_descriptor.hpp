@@ -10,21 +10,22 @@
 //                                                   its state from a simulated car's state
 // optionally its YAML parameter table
 //   using Params; static std::vector<ParamField> params(Params&); static Model make(const Params&);
-// and optionally a GPU twin (kernels/): the GLSL file kernels/shaders/models/<kGpuKernel>.glsl
+// and optionally a GPU twin (vulkan/): the GLSL file vulkan/shaders/models/<kGpuKernel>.glsl
 // and the floats of the parameter block it reads, named as the GLSL code names them
 //   static constexpr const char* kGpuKernel;
 //   static std::vector<GpuField<Model>> gpu_fields();
 //   static bool gpu_tail(const Model&, GpuTail& tail, std::string* why);   (optional: arrays
 //                                                   after the named floats, shader constants)
 // The line MPPI_REGISTER_MODEL(Descriptor) in the header enters it into the compile-time list of
-// models (mppi/generated/model_list.hpp, collected by the build from dynamics/models/*.hpp).
+// models (<build>/generated/dynamics/model_list.hpp, collected by the build from
+// dynamics/models/*.hpp).
 #include <concepts>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "base/param_table.hpp"
 #include "mppi/concepts.hpp"
-#include "mppi/param_table.hpp"
 
 namespace mppi {
 

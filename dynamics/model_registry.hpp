@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "dynamics/model_descriptor.hpp"
-#include "mppi/error.hpp"
-#include "mppi/model_list.hpp"  // generated: RegisteredModels
+#include "base/error.hpp"
+#include "dynamics/model_list.hpp"  // generated: RegisteredModels
 
 namespace mppi {
 
@@ -59,7 +59,7 @@ inline std::string models_help() {
         out += "  " + table.substr(begin, end - begin + 1);
       }
     }
-    if constexpr (HasGpuTwin<D>) out += std::string("  GPU twin: kernels/shaders/models/") + D::kGpuKernel + ".glsl\n";
+    if constexpr (HasGpuTwin<D>) out += std::string("  GPU twin: vulkan/shaders/models/") + D::kGpuKernel + ".glsl\n";
   });
   return out;
 }

@@ -8,8 +8,8 @@
 #include <cmath>
 #include <string>
 
+#include "base/fast_math.hpp"
 #include "dynamics/fast_trig.hpp"
-#include "mppi/fast_math.hpp"
 
 namespace mppi {
 

@@ -9,8 +9,8 @@
 #include <string_view>
 #include <vector>
 
+#include "base/param_table.hpp"
 #include "dynamics/pacejka.hpp"
-#include "mppi/param_table.hpp"
 
 namespace mppi {
 

@@ -1,16 +1,16 @@
 // YAML <-> the physics models' parameters, through their parameter tables
-// (dynamics/vehicle_params.hpp, mppi/param_yaml.hpp): strict, every mistake is an mppi::Error
+// (dynamics/vehicle_params.hpp, base/param_yaml.hpp): strict, every mistake is an mppi::Error
 // naming the file, line and key.
 #include <string>
 #include <vector>
 
-#include "dynamics/models/double_track.hpp"
-#include "dynamics/models/full_vehicle.hpp"
-#include "dynamics/models/kinematic.hpp"
-#include "dynamics/models/single_track.hpp"
+#include "base/error.hpp"
+#include "base/param_yaml.hpp"
+#include "dynamics/models/double_track_model.hpp"
+#include "dynamics/models/full_vehicle_model.hpp"
+#include "dynamics/models/kinematic_model.hpp"
+#include "dynamics/models/single_track_model.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/error.hpp"
-#include "mppi/param_yaml.hpp"
 
 namespace mppi {
 

@@ -2,8 +2,8 @@
 // map (bounds 0..1.6 m at 10 pixels per meter); the first byte picks the channel and the row order.
 // The rest is decoded from memory by CostMap::decode_image, the part of CostMap::load_image after
 // it has read the file (every check of the loader is there; no file is written per input).
-#include "costs/cost_map.hpp"
 #include "fuzz/fuzz_input.hpp"
+#include "mppi/cost_map.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;

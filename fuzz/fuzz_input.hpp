@@ -10,7 +10,7 @@
 #include <string>
 #include <unistd.h>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::fuzz {
 

@@ -1,11 +1,11 @@
-// NumPy .npz reader (dynamics/npz.cpp, libzip) and the readers of what it holds: the AutoRally
+// NumPy .npz reader (base/npz.cpp, libzip) and the readers of what it holds: the AutoRally
 // cost map (costs/cost_map_io.cpp), network weights (dynamics/autorally_nn_load.cpp) and the
 // basis-function model (dynamics/autorally_bf.hpp).
-#include "costs/cost_map.hpp"
+#include "base/npz.hpp"
 #include "dynamics/autorally_bf.hpp"
 #include "dynamics/autorally_nn.hpp"
-#include "dynamics/npz.hpp"
 #include "fuzz/fuzz_input.hpp"
+#include "mppi/cost_map.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string path = mppi::fuzz::write_temp_file(data, size, ".npz");

@@ -1,10 +1,10 @@
 // Recording CSV reader (sim/recording.cpp) and the diagnosis preparation of what it read
-// (sysid/diagnose/data.cpp: columns, pieces, sample interval).
+// (diagnose/data.cpp: columns, pieces, sample interval).
 #include <sstream>
 
+#include "diagnose/data.hpp"
 #include "fuzz/fuzz_input.hpp"
 #include "sim/recording.hpp"
-#include "sysid/diagnose/data.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   mppi::fuzz::expect_value_or_error([&] {

@@ -2,8 +2,8 @@
 // costs/python_dict_text.cpp). The input is parsed as text by CostMap::parse_autorally_track_cfg,
 // the part of CostMap::read_autorally_track_cfg after it has read the file (every check of the
 // reader is there; no file is written per input).
-#include "costs/cost_map.hpp"
 #include "fuzz/fuzz_input.hpp"
+#include "mppi/cost_map.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text = mppi::fuzz::as_text(data, size);

@@ -1,5 +1,5 @@
 // YAML loaders of the vehicle models' parameters (dynamics/vehicle_params_io.cpp over
-// mppi/param_yaml.cpp and mppi/yaml_number.cpp). The first byte picks the model.
+// base/param_yaml.cpp and base/yaml_number.cpp). The first byte picks the model.
 #include "dynamics/vehicle_params.hpp"
 #include "fuzz/fuzz_input.hpp"
 

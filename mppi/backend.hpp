@@ -9,7 +9,7 @@
 #include <string>
 #include <string_view>
 
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 
 namespace mppi {
 

@@ -1,9 +1,9 @@
 #pragma once
 // Which backend runs the rollouts: asked for by the user (mppi-sim --backend, the API), and
-// what was actually used and why (kernels/make_controller.hpp does the choosing).
+// what was actually used and why (factory/make_controller.hpp does the choosing).
 #include <string>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi {
 

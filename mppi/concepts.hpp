@@ -1,11 +1,11 @@
 #pragma once
 // What the controller asks of a dynamics model and of a running cost. Both work on a
-// fixed-width SoA batch (mppi/batch.hpp) and are called inside the per-sample hot loop:
+// fixed-width SoA batch (base/batch.hpp) and are called inside the per-sample hot loop:
 // no allocation, no exceptions, no virtual calls, branch-free lane loops.
 #include <concepts>
 #include <cstddef>
 
-#include "mppi/batch.hpp"
+#include "base/batch.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi {

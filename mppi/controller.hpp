@@ -21,12 +21,12 @@
 #include <utility>
 #include <vector>
 
+#include "base/error.hpp"
+#include "base/multiversion.hpp"
 #include "mppi/backend.hpp"
 #include "mppi/controller_options.hpp"
 #include "mppi/cpu_backend.hpp"
-#include "mppi/error.hpp"
 #include "mppi/fault_injection.hpp"
-#include "mppi/multiversion.hpp"
 #include "mppi/noise.hpp"
 #include "mppi/savitzky_golay.hpp"
 #include "mppi/thread_schedule.hpp"

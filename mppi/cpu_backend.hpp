@@ -17,11 +17,11 @@
 #include <immintrin.h>
 #endif
 
+#include "base/batch.hpp"
+#include "base/error.hpp"
+#include "base/multiversion.hpp"
 #include "mppi/backend.hpp"
-#include "mppi/batch.hpp"
 #include "mppi/concepts.hpp"
-#include "mppi/error.hpp"
-#include "mppi/multiversion.hpp"
 #include "mppi/noise.hpp"
 #include "mppi/sample_step.hpp"
 #include "mppi/thread_schedule.hpp"

@@ -9,8 +9,8 @@
 #include <string>
 #include <utility>
 
+#include "base/error.hpp"
 #include "mppi/backend.hpp"
-#include "mppi/error.hpp"
 
 namespace mppi {
 

@@ -17,8 +17,8 @@
 #include <immintrin.h>
 #endif
 
-#include "mppi/batch.hpp"
-#include "mppi/fast_math.hpp"
+#include "base/batch.hpp"
+#include "base/fast_math.hpp"
 
 namespace mppi {
 

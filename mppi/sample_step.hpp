@@ -8,7 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "mppi/fast_math.hpp"
+#include "base/fast_math.hpp"
 #include "mppi/noise.hpp"
 
 namespace mppi::detail {

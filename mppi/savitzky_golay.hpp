@@ -6,7 +6,7 @@
 #include <Eigen/Dense>
 #include <vector>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi {
 

@@ -7,7 +7,7 @@
 #include <span>
 #include <vector>
 
-#include "mppi/batch.hpp"
+#include "base/batch.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi {

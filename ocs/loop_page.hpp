@@ -1,6 +1,6 @@
 #pragma once
 // The operator page for a controller that runs in its own control loop against a chassis over
-// UDP (chassis/examples/mppi_udp_drive.cpp), e.g. on a real vehicle. The loop calls
+// UDP (apps/mppi_udp_drive.cpp), e.g. on a real vehicle. The loop calls
 // apply_requests() before and after_step() after each controller step; neither waits on the
 // network. There is no pause on a vehicle: the page's runstop is the operator's stop, sent by
 // the loop as its runstop messages (motion_allowed()).

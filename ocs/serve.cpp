@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "ocs/live_observer.hpp"
 #include "ocs/recording_json.hpp"
 #include "ocs/server.hpp"

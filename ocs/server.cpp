@@ -8,7 +8,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "ocs/assets.hpp"
 #include "ocs/frame_json.hpp"
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "sim/track.hpp"
 
 namespace mppi::ocs {

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::plot {
 

@@ -8,7 +8,7 @@
 #include <memory>
 #include <mutex>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::plot {
 

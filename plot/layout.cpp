@@ -5,7 +5,7 @@
 #include <limits>
 #include <sstream>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::plot {
 

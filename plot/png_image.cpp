@@ -7,7 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #pragma GCC diagnostic pop
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::plot {
 

@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <mutex>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "plot/figure.hpp"
 #include "plot/layout.hpp"
 

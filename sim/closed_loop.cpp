@@ -13,14 +13,14 @@
 #include "chassis/sim_adapter.hpp"
 #include "costs/autorally_cost.hpp"
 #include "costs/cost_config.hpp"
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "dynamics/corrected_model.hpp"
 #include "dynamics/with_effects.hpp"
 #include "dynamics/model_registry.hpp"
 #include "dynamics/four_wheel_observe.hpp"
 #include "mppi/controller.hpp"
-#include "mppi/error.hpp"
-#include "mppi/make_controller.hpp"
+#include "base/error.hpp"
+#include "factory/make_controller.hpp"
 #include "sim/crash_detector.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/geometry.hpp"
@@ -87,7 +87,7 @@ struct ControllerSetup {
   PathPredictor predict;  // the controller model's paths, for an observer
 };
 
-// The controller on the backend the config asks for (mppi/make_controller.hpp).
+// The controller on the backend the config asks for (factory/make_controller.hpp).
 struct BuiltController {
   std::unique_ptr<Controller> controller;
   std::string backend;

@@ -10,8 +10,8 @@
 #include <utility>
 #include <vector>
 
-#include "dynamics/models/autorally_nn.hpp"
-#include "dynamics/models/single_track.hpp"
+#include "dynamics/models/autorally_nn_model.hpp"
+#include "dynamics/models/single_track_model.hpp"
 #include "mppi/backend_choice.hpp"
 #include "mppi/controller_options.hpp"
 #include "sim/plant.hpp"
@@ -41,7 +41,7 @@ struct ClosedLoopConfig {
   double stall_timeout_s = 10.0;
   double stall_progress_m = 2.0;
   ControllerOptions controller;           // K, T, seed, threads, noise, lambda, ...
-  BackendChoice backend = BackendChoice::kCpu;  // rollout backend: cpu | vulkan | auto (mppi/make_controller.hpp)
+  BackendChoice backend = BackendChoice::kCpu;  // rollout backend: cpu | vulkan | auto (factory/make_controller.hpp)
   BackendReport* backend_report = nullptr;  // if set, receives the backend that ran and why
   std::string cost_params_yaml;           // AutoRally cost weights; empty = data/config default
   std::string plant_params_yaml;          // plant's data file; empty = its default (data/config)

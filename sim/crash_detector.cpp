@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <limits>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::sim {
 

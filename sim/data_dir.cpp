@@ -3,7 +3,7 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 #ifndef MPPI_DEFAULT_DATA_DIR
 #define MPPI_DEFAULT_DATA_DIR "data"

@@ -4,7 +4,7 @@
 #include <limits>
 #include <string>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::sim {
 

@@ -6,7 +6,7 @@
 #include <memory>
 #include <vector>
 
-#include "mppi/batch.hpp"
+#include "base/batch.hpp"
 #include "mppi/concepts.hpp"
 #include "sim/step_observer.hpp"
 

@@ -7,9 +7,9 @@
 #include <cmath>
 #include <vector>
 
-#include "mppi/batch.hpp"
+#include "base/batch.hpp"
+#include "base/error.hpp"
 #include "mppi/concepts.hpp"
-#include "mppi/error.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi::sim {

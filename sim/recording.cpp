@@ -8,7 +8,7 @@
 #include <set>
 #include <string_view>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::sim {
 

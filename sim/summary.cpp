@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::sim {
 

@@ -8,7 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <yaml-cpp/yaml.h>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::sim {
 namespace {

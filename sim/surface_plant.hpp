@@ -8,8 +8,8 @@
 #include <map>
 #include <memory>
 
+#include "base/batch.hpp"
 #include "dynamics/single_track.hpp"
-#include "mppi/batch.hpp"
 #include "sim/surface_map.hpp"
 
 namespace mppi::sim {

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <limits>
 
-#include "dynamics/npz.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
+#include "base/npz.hpp"
 #include "sim/data_dir.hpp"
 
 namespace mppi::sim {

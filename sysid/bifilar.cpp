@@ -5,7 +5,7 @@
 #include <limits>
 #include <numbers>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::sysid {
 

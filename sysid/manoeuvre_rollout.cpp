@@ -6,7 +6,7 @@
 #include <random>
 #include <string>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi::sysid {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::sysid {
 

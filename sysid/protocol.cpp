@@ -10,9 +10,9 @@
 #include <random>
 #include <utility>
 
+#include "base/error.hpp"
 #include "dynamics/full_vehicle.hpp"
 #include "dynamics/model_registry.hpp"
-#include "mppi/error.hpp"
 #include "sim/plant.hpp"
 
 namespace mppi::sysid {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "plot/figure.hpp"
 
 namespace mppi::sysid {

@@ -11,7 +11,7 @@
 #include <sstream>
 #include <string_view>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::sysid {
 

@@ -10,7 +10,7 @@
 #include "dynamics/model_registry.hpp"
 #include "dynamics/full_vehicle.hpp"
 #include "dynamics/single_track.hpp"
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi::sysid {

@@ -3,7 +3,7 @@
 #include <functional>
 #include <string>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 
 namespace mppi::test {
 inline std::string error_of(const std::function<void()>& f) {

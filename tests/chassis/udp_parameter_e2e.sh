@@ -15,8 +15,8 @@ sleep 0.5
   --duration 5 > "$OUT/drive.txt" 2> "$OUT/drive.err" &
 DRIVE=$!
 sleep 2
-/usr/bin/python3 "$SRC/chassis/examples/udp_client.py" --param-port $PARAM_PORT --set target_speed_mps=7.5
-/usr/bin/python3 "$SRC/chassis/examples/udp_client.py" --param-port $PARAM_PORT --set no_such_weight=1
+/usr/bin/python3 "$SRC/apps/udp_client.py" --param-port $PARAM_PORT --set target_speed_mps=7.5
+/usr/bin/python3 "$SRC/apps/udp_client.py" --param-port $PARAM_PORT --set no_such_weight=1
 wait $DRIVE; RC=$?
 kill $BRIDGE 2>/dev/null; wait $BRIDGE 2>/dev/null
 cat "$OUT/drive.err" "$OUT/drive.txt"

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "costs/autorally_cost.hpp"
-#include "costs/cost_map.hpp"
 #include "mppi/concepts.hpp"
+#include "mppi/cost_map.hpp"
 #include "test_data.hpp"
 
 namespace {

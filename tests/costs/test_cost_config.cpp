@@ -3,8 +3,8 @@
 #include <functional>
 #include <string>
 
+#include "base/error.hpp"
 #include "costs/cost_config.hpp"
-#include "mppi/error.hpp"
 #include "error_of.hpp"
 #include "test_data.hpp"
 

@@ -14,10 +14,10 @@
 #include <string>
 #include <vector>
 
-#include "costs/cost_map.hpp"
+#include "base/error.hpp"
+#include "base/npz.hpp"
 #include "costs/python_dict_text.hpp"
-#include "dynamics/npz.hpp"
-#include "mppi/error.hpp"
+#include "mppi/cost_map.hpp"
 #include "error_of.hpp"
 #include "test_data.hpp"
 

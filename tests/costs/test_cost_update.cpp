@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "costs/autorally_cost.hpp"
-#include "costs/cost_map.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
 #include "mppi/controller.hpp"
+#include "mppi/cost_map.hpp"
 #include "mppi/cpu_backend.hpp"
 #include "test_data.hpp"
 

@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
+#include "base/npz.hpp"
 #include "costs/autorally_cost.hpp"
-#include "costs/cost_map.hpp"
-#include "dynamics/models/autorally_bf.hpp"
-#include "dynamics/npz.hpp"
-#include "mppi/make_controller.hpp"
+#include "dynamics/models/autorally_bf_model.hpp"
+#include "factory/make_controller.hpp"
+#include "mppi/cost_map.hpp"
 #include "sim/closed_loop.hpp"
 #include "test_data.hpp"
 

@@ -7,10 +7,10 @@
 #include <random>
 #include <vector>
 
+#include "base/error.hpp"
+#include "base/npz.hpp"
 #include "dynamics/autorally_nn.hpp"
-#include "dynamics/npz.hpp"
 #include "mppi/concepts.hpp"
-#include "mppi/error.hpp"
 #include "test_data.hpp"
 
 static_assert(mppi::Dynamics<mppi::AutoRallyNetwork>);

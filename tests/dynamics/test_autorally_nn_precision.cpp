@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "base/batch.hpp"
 #include "dynamics/autorally_nn.hpp"
-#include "mppi/batch.hpp"
 #include "test_data.hpp"
 
 namespace {

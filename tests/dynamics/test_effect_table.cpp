@@ -8,10 +8,10 @@
 #include <set>
 #include <string>
 
+#include "base/error.hpp"
+#include "base/type_list.hpp"
 #include "dynamics/corrected_model.hpp"
 #include "dynamics/with_effects.hpp"
-#include "mppi/error.hpp"
-#include "mppi/type_list.hpp"
 #include "sim/data_dir.hpp"
 
 using namespace mppi;

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "base/error.hpp"
+#include "base/npz.hpp"
 #include "dynamics/mlp.hpp"
-#include "dynamics/npz.hpp"
-#include "mppi/error.hpp"
 #include "test_data.hpp"
 
 namespace {

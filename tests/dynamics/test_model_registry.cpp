@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
+#include "base/error.hpp"
+#include "base/param_yaml.hpp"
 #include "dynamics/model_registry.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/error.hpp"
-#include "mppi/param_yaml.hpp"
 #include "test_data.hpp"
 
 namespace {

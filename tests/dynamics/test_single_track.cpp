@@ -463,7 +463,7 @@ TEST_CASE("SingleTrack rejects invalid parameters and initialises rolling wheels
 TEST_CASE("Vehicle parameter YAML: the shipped file, strict keys, errors with file and line",
           "[physics][params]") {
   // The shipped uncalibrated variant restates the defaults (so the two cannot drift apart
-  // silently); the default file holds the calibrated values (tests/sysid/test_calibration.cpp).
+  // silently); the default file holds the calibrated values (tests/sysid/test_plant_calibration.cpp).
   const auto path = mppi::test::data_path("config/autorally_single_track_uncalibrated.yaml");
   const SingleTrackParams loaded = mppi::load_single_track_params(path);
   const SingleTrackParams d;

@@ -7,9 +7,9 @@
 
 #include "chassis/calibration.hpp"
 #include "chassis/priorities.hpp"
+#include "diagnose/data.hpp"
 #include "dynamics/corrected_model.hpp"
 #include "sim/recording.hpp"
-#include "sysid/diagnose/data.hpp"
 #include "error_of.hpp"
 
 using mppi::test::error_of;

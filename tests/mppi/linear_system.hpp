@@ -1,7 +1,7 @@
 #pragma once
 // A double integrator with a quadratic cost, as an mppi::Dynamics / mppi::StageCost pair, for
 // tests that compare MPPI with closed forms.
-#include "mppi/batch.hpp"
+#include "base/batch.hpp"
 
 namespace mppi::test {
 

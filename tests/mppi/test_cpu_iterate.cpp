@@ -10,7 +10,7 @@
 #include <memory>
 #include <vector>
 
-#include "bench/peer_workload.hpp"
+#include "apps/bench/peer_workload.hpp"
 #include "mppi/controller.hpp"
 #include "tests/mppi/linear_system.hpp"
 

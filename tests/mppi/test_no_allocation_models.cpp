@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "costs/autorally_cost.hpp"
-#include "costs/cost_map.hpp"
 #include "dynamics/model_registry.hpp"
 #include "dynamics/with_effects.hpp"
-#include "mppi/make_controller.hpp"
+#include "factory/make_controller.hpp"
+#include "mppi/cost_map.hpp"
 #include "test_data.hpp"
 #include "tests/mppi/allocation_counter.hpp"
 

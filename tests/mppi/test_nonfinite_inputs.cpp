@@ -9,9 +9,9 @@
 #include <string>
 
 #include "costs/cost_config.hpp"
-#include "costs/cost_map.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/vehicle_params.hpp"
+#include "mppi/cost_map.hpp"
 #include "tests/error_of.hpp"
 
 using mppi::test::error_of;

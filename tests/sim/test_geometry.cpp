@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/geometry.hpp"
 
 using namespace mppi::sim;

@@ -3,8 +3,8 @@
 // plant as it was.
 #include <catch2/catch.hpp>
 
+#include "base/error.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
-#include "mppi/error.hpp"
 #include "sim/plant.hpp"
 
 using namespace mppi;

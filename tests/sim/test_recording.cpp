@@ -11,7 +11,7 @@
 
 #include <unistd.h>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/recording.hpp"
 
 using namespace mppi::sim;

@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/summary.hpp"
 
 using namespace mppi::sim;

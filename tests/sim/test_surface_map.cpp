@@ -10,9 +10,9 @@
 #include <fstream>
 #include <memory>
 
+#include "base/error.hpp"
 #include "dynamics/single_track.hpp"
 #include "dynamics/with_effects.hpp"
-#include "mppi/error.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/recording.hpp"
 #include "sim/surface_map.hpp"

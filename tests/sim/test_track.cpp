@@ -5,7 +5,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/track.hpp"
 #include "test_data.hpp"

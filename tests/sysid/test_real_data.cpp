@@ -8,7 +8,7 @@
 #include <functional>
 #include <fstream>
 
-#include "mppi/error.hpp"
+#include "base/error.hpp"
 #include "sysid/real_data.hpp"
 #include "test_data.hpp"
 

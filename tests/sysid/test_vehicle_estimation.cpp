@@ -6,8 +6,8 @@
 #include <limits>
 #include <random>
 
+#include "base/error.hpp"
 #include "dynamics/vehicle_params.hpp"
-#include "mppi/error.hpp"
 #include "sysid/vehicle_estimation.hpp"
 
 using namespace mppi;

@@ -12,8 +12,8 @@
 
 #include "costs/autorally_cost.hpp"
 #include "dynamics/single_track.hpp"
-#include "kernels/vulkan_backend.hpp"
 #include "mppi/cpu_backend.hpp"
+#include "vulkan/vulkan_backend.hpp"
 #include "test_data.hpp"
 #include "vulkan/vulkan_test_util.hpp"
 

@@ -15,11 +15,12 @@
 #include <vector>
 
 #include "costs/autorally_cost.hpp"
-#include "costs/cost_map.hpp"
+#include "mppi/cost_map.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
 #include "dynamics/single_track.hpp"
-#include "kernels/make_controller.hpp"
+#include "factory/make_controller.hpp"
+#include "vulkan/vulkan_backend.hpp"
 #include "mppi/controller.hpp"
 #include "vulkan/vulkan_test_util.hpp"
 

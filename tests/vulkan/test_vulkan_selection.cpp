@@ -9,7 +9,8 @@
 
 #include "costs/autorally_cost.hpp"
 #include "dynamics/kinematic_bicycle.hpp"
-#include "kernels/make_controller.hpp"
+#include "factory/make_controller.hpp"
+#include "vulkan/vulkan_backend.hpp"
 #include "tests/mppi/linear_system.hpp"
 #include "vulkan/vulkan_test_util.hpp"
 

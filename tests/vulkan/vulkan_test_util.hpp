@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <string>
 
-#include "kernels/vulkan_backend.hpp"
+#include "vulkan/vulkan_backend.hpp"
 
 namespace mppi::test {
 

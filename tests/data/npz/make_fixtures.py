@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Writes the tiny .npz fixtures of tests/dynamics/test_npz.cpp (run from this folder with
+"""Writes the tiny .npz fixtures of tests/base/test_npz.cpp (run from this folder with
 Debian's /usr/bin/python3 + numpy). The values are simple formulas so the test can check them
 without reading numpy: a[i] = ... as noted per array."""
 import io

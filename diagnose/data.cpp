@@ -1,0 +1,186 @@
+#include "diagnose/data.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "base/error.hpp"
+#include "sysid/real_data.hpp"
+
+namespace mppi::diagnose {
+
+DiagData prepare(const sim::Recording& rec, const std::string& source, std::size_t min_rows,
+                 const ScreenOptions& screen) {
+  DiagData d;
+  d.source = source;
+  for (const auto& c : sim::kRecordingRequiredColumns)
+    if (!rec.has_column(c)) throw Error(source + ": missing required column '" + c + "'");
+  d.t = rec.column("t");
+  d.x = rec.column("x");
+  d.y = rec.column("y");
+  d.yaw = rec.column("yaw");
+  d.vx = rec.column("vx");
+  d.vy = rec.column("vy");
+  d.r = rec.column("yaw_rate");
+  d.steer = rec.column("steer");
+  d.throttle = rec.column("throttle");
+  if (rec.has_column("roll")) d.roll = rec.column("roll");
+  const auto src = rec.metadata.find("source");
+  d.control_lead = (src != rec.metadata.end() &&
+                    (src->second == "mppi-sim" || src->second.rfind("mppi-fit synth", 0) == 0))
+                       ? 1 : 0;
+  const auto command = rec.metadata.find("throttle_command");
+  if (command != rec.metadata.end()) {
+    if (command->second != "speed" && command->second != "throttle")
+      throw Error(source + ": metadata 'throttle_command: " + command->second + "': expected 'speed' or 'throttle'");
+    d.speed_command = command->second == "speed";
+  }
+  const std::size_t n = d.t.size();
+  min_rows = std::max<std::size_t>(min_rows, 2);  // the sample interval needs two rows
+  if (n < min_rows)
+    throw Error(source + ": too short for diagnosis: " + std::to_string(n) + " rows, need at least " +
+                std::to_string(min_rows));
+  std::vector<double> dts;
+  for (std::size_t k = 1; k < n; ++k) dts.push_back(d.t[k] - d.t[k - 1]);
+  std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
+  d.dt_s = dts[dts.size() / 2];
+  if (!(d.dt_s > 0)) throw Error(source + ": cannot determine the sample interval");
+  std::vector<ScreenColumn> columns = {{"t", &d.t},   {"x", &d.x},   {"y", &d.y},
+                                       {"yaw", &d.yaw}, {"vx", &d.vx}, {"vy", &d.vy},
+                                       {"yaw_rate", &d.r}, {"steer", &d.steer}, {"throttle", &d.throttle}};
+  if (!d.roll.empty()) columns.push_back({"roll", &d.roll});
+  d.flags = screen_columns(d.t, columns, screen);
+  for (ScreenFlag& f : d.flags) f.file = source;
+  const std::vector<char> screened = screened_rows(n, d.flags, screen.guard_rows);
+  // Pieces: cut at NaN rows, screened rows, gaps > 3 median intervals, position jumps no car
+  // makes, and displacements that the measured velocities do not account for (a respawn or a
+  // teleport: at a low sample rate a jump of a track's half width is within what a car covers
+  // between two rows, but not in that direction or at that speed).
+  auto unexplained_displacement_m = [&](std::size_t k) {
+    const double dt = d.t[k] - d.t[k - 1];
+    const double c0 = std::cos(d.yaw[k - 1]), s0 = std::sin(d.yaw[k - 1]);
+    const double c1 = std::cos(d.yaw[k]), s1 = std::sin(d.yaw[k]);
+    const double px = 0.5 * dt * (c0 * d.vx[k - 1] - s0 * d.vy[k - 1] + c1 * d.vx[k] - s1 * d.vy[k]);
+    const double py = 0.5 * dt * (s0 * d.vx[k - 1] + c0 * d.vy[k - 1] + s1 * d.vx[k] + c1 * d.vy[k]);
+    return std::hypot(d.x[k] - d.x[k - 1] - px, d.y[k] - d.y[k - 1] - py);
+  };
+  auto row_ok = [&](std::size_t k) {
+    const double vals[] = {d.t[k], d.x[k], d.y[k], d.yaw[k], d.vx[k], d.vy[k], d.r[k], d.steer[k], d.throttle[k]};
+    bool ok = !screened[k];
+    for (double v : vals) ok = ok && std::isfinite(v);
+    return ok;
+  };
+  // The threshold (also the slack of the position-jump rule) scales with the recording's own
+  // typical disagreement (position noise, a fused estimate's lag), so that noisy positions do
+  // not cut everywhere.
+  double teleport_m = 0.25;
+  {
+    std::vector<double> e;
+    for (std::size_t k = 1; k < n; ++k)
+      if (row_ok(k) && row_ok(k - 1) && d.t[k] - d.t[k - 1] <= 3 * d.dt_s) e.push_back(unexplained_displacement_m(k));
+    if (!e.empty()) {
+      std::nth_element(e.begin(), e.begin() + static_cast<std::ptrdiff_t>(e.size() / 2), e.end());
+      teleport_m = std::max(teleport_m, 10.0 * e[e.size() / 2]);
+    }
+  }
+  d.piece.assign(n, -1);
+  int id = -1;
+  bool open = false;
+  std::size_t usable = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const bool ok = row_ok(k);
+    if (screened[k]) ++d.screened_rows;
+    if (!ok) {
+      open = false;
+      continue;
+    }
+    if (open && k > 0) {
+      const double gap = d.t[k] - d.t[k - 1];
+      const double jump = std::hypot(d.x[k] - d.x[k - 1], d.y[k] - d.y[k - 1]);
+      const double vmax = std::max(std::abs(d.vx[k]), std::abs(d.vx[k - 1])) + 2.0;
+      if (gap > 3 * d.dt_s || jump > 3 * vmax * gap + teleport_m || unexplained_displacement_m(k) > teleport_m) open = false;
+    }
+    if (!open) {
+      ++id;
+      open = true;
+    }
+    d.piece[k] = id;
+    ++usable;
+  }
+  if (usable < min_rows)
+    throw Error(source + ": only " + std::to_string(usable) + " usable rows (no empty fields), need " +
+                std::to_string(min_rows));
+  return d;
+}
+
+DiagData load_recording(const std::string& path) {
+  return prepare(sim::RecordingReader::read(path), path);
+}
+
+DiagData concat(const DiagData& a, const DiagData& b) {
+  if (a.control_lead != b.control_lead)
+    throw Error(a.source + " and " + b.source + ": recordings of different kinds (command timing) cannot be combined");
+  if (a.speed_command != b.speed_command)
+    throw Error(a.source + " and " + b.source + ": one declares its throttle column a speed command "
+                "('# throttle_command: speed'), the other not; they cannot be combined");
+  DiagData d = a;
+  d.source = a.source + " + " + b.source;
+  const double shift = a.t.back() + 10.0 - b.t.front();
+  int max_piece = -1;
+  for (int p : a.piece) max_piece = std::max(max_piece, p);
+  auto append = [](std::vector<double>& to, const std::vector<double>& from, double add) {
+    for (double v : from) to.push_back(v + add);
+  };
+  append(d.t, b.t, shift);
+  append(d.x, b.x, 0);
+  append(d.y, b.y, 0);
+  append(d.yaw, b.yaw, 0);
+  append(d.vx, b.vx, 0);
+  append(d.vy, b.vy, 0);
+  append(d.r, b.r, 0);
+  append(d.steer, b.steer, 0);
+  append(d.throttle, b.throttle, 0);
+  if (!a.roll.empty() && !b.roll.empty()) append(d.roll, b.roll, 0);
+  else d.roll.clear();  // roll only where both recordings have it
+  for (int p : b.piece) d.piece.push_back(p < 0 ? -1 : p + max_piece + 1);
+  for (ScreenFlag f : b.flags) {
+    f.row += a.rows();
+    d.flags.push_back(std::move(f));
+  }
+  d.screened_rows += b.screened_rows;
+  return d;
+}
+
+DiagData load_any(const std::string& spec) {
+  return prepare(sysid::load_any_recording(spec), spec);
+}
+
+Split make_split(const DiagData& d, const std::string& holdout) {
+  Split s;
+  s.heldout.assign(d.rows(), 0);
+  const auto colon = holdout.find(':');
+  try {
+    if (colon == std::string::npos) {
+      std::size_t used = 0;
+      const double f = std::stod(holdout, &used);
+      if (used != holdout.size() || !(f > 0.05 && f < 0.95)) throw std::invalid_argument(holdout);
+      const auto first = static_cast<std::size_t>((1.0 - f) * static_cast<double>(d.rows()));
+      for (std::size_t k = first; k < d.rows(); ++k) s.heldout[k] = 1;
+    } else {
+      const double t0 = std::stod(holdout.substr(0, colon));
+      const double t1 = std::stod(holdout.substr(colon + 1));
+      if (!(t1 > t0)) throw std::invalid_argument(holdout);
+      for (std::size_t k = 0; k < d.rows(); ++k) s.heldout[k] = d.t[k] >= t0 && d.t[k] < t1;
+    }
+  } catch (const std::logic_error&) {
+    throw Error("--holdout: expected a fraction in (0.05, 0.95) or a time range T0:T1 in s, got '" +
+                holdout + "'");
+  }
+  std::size_t h = 0;
+  for (char c : s.heldout) h += c;
+  if (h < 100 || d.rows() - h < 150)
+    throw Error(d.source + ": --holdout " + holdout + " leaves " + std::to_string(d.rows() - h) +
+                " training and " + std::to_string(h) + " held-out rows (need >= 150 and >= 100)");
+  return s;
+}
+
+}  // namespace mppi::diagnose

@@ -1,0 +1,367 @@
+#include "diagnose/diagnose.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "plot/figure_json.hpp"
+#include "plot/html_report.hpp"
+
+#include "base/error.hpp"
+#include "diagnose/control_loss.hpp"
+#include "diagnose/plots.hpp"
+
+namespace mppi::diagnose {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+// The values screened out of the recording (screen.hpp); at most kMaxListedFlags listed.
+constexpr std::size_t kMaxListedFlags = 200;
+json screening_json(const DiagData& d) {
+  json flags = json::array();
+  for (std::size_t i = 0; i < d.flags.size() && i < kMaxListedFlags; ++i) {
+    const ScreenFlag& f = d.flags[i];
+    // The value as text: JSON has no NaN or inf.
+    char value[32];
+    std::snprintf(value, sizeof value, "%.6g", f.value);
+    flags.push_back({{"file", f.file}, {"row", f.row}, {"t_s", num(f.t_s)}, {"column", f.column},
+                     {"value", value}, {"kind", f.kind}});
+  }
+  return {{"flagged", d.flags.size()}, {"rows_dropped", d.screened_rows}, {"flags", flags}};
+}
+
+json metrics_json(const std::vector<HorizonMetrics>& ms) {
+  json out = json::array();
+  for (const auto& m : ms) {
+    json j;
+    j["horizon_s"] = m.horizon_s;
+    j["starts"] = m.starts;
+    for (int c = 0; c < kChannels; ++c) {
+      j["rmse"][kChannelNames[c]] = num(m.rmse[c]);
+      j["fit_percent"][kChannelNames[c]] = num(m.fit_percent[c]);
+    }
+    j["position_rmse_m"] = num(m.position_rmse_m);
+    j["normalized_rmse"] = num(m.normalized_rmse);
+    out.push_back(j);
+  }
+  return out;
+}
+
+const HorizonMetrics* at_horizon(const std::vector<HorizonMetrics>& ms, double h) {
+  for (const auto& m : ms)
+    if (std::abs(m.horizon_s - h) < 1e-9) return &m;
+  return nullptr;
+}
+
+}  // namespace
+
+DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, const DiagnoseOptions& o) {
+  DiagnoseResult res;
+  const Split split = make_split(d, o.holdout);
+  std::vector<char> train(d.rows()), held = split.heldout;
+  for (std::size_t k = 0; k < d.rows(); ++k) train[k] = !held[k];
+  const auto nominal_ptr = nominal.make({});
+  const ReplayModel& nominal_model = *nominal_ptr;
+
+  // 1. Locate (training part: the held-out part is kept for judging the correction).
+  const ResidualSeries rs = residual_series(nominal_model, d, o.locate_horizon_s, o.replay);
+  res.mismatch = locate(d, rs, train);
+
+  // 2. Name, without the rows of lost control where enough is left.
+  std::vector<char> select_rows = train;
+  const std::vector<char> lost = control_loss_rows(d, o.control_loss);
+  std::size_t n_train = 0;
+  for (std::size_t k = 0; k < d.rows(); ++k) {
+    n_train += train[k] != 0;
+    res.control_loss_rows += train[k] && lost[k];
+  }
+  std::string control_loss_line;
+  if (res.control_loss_rows > 0) {
+    for (std::size_t k = 0; k < d.rows(); ++k)
+      if (lost[k]) select_rows[k] = 0;
+    const int len = std::max(2, static_cast<int>(std::lround(o.selection.fit_horizon_s / d.dt_s)));
+    const bool enough = 2 * res.control_loss_rows < n_train && make_segments(d, select_rows, len, len).size() >= 12;
+    char line[320];
+    std::snprintf(line, sizeof line,
+                  "%zu of %zu training rows (%.1f %%) are lost control (body slip > %.0f deg above %.1f m/s, and %.1f s around): %s",
+                  res.control_loss_rows, n_train, 100.0 * static_cast<double>(res.control_loss_rows) / static_cast<double>(n_train),
+                  o.control_loss.max_body_slip_deg, o.control_loss.min_speed_mps, o.control_loss.guard_s,
+                  enough ? "left out of the fits and their validation" : "kept (too little would be left)");
+    control_loss_line = line;
+    if (!enough) select_rows = train;
+    if (o.selection.progress) o.selection.progress(control_loss_line);
+  }
+  res.selection = select_effects(d, nominal, select_rows, held, o.selection, o.replay);
+  if (!control_loss_line.empty()) res.selection.log.insert(res.selection.log.begin(), control_loss_line);
+  const auto corrected_ptr = nominal.make(res.selection.final_effects);
+  const ReplayModel& corrected = *corrected_ptr;
+
+  // 4. Show (held out): one-step, then the multi-step horizons.
+  std::vector<double> hs = {d.dt_s};
+  hs.insert(hs.end(), o.horizons_s.begin(), o.horizons_s.end());
+  res.before = horizon_metrics(nominal_model, d, held, hs, 5, o.replay);
+  res.after = horizon_metrics(corrected, d, held, hs, 5, o.replay);
+  const HorizonMetrics* hb = at_horizon(res.before, o.headline_horizon_s);
+  const HorizonMetrics* ha = at_horizon(res.after, o.headline_horizon_s);
+  if (hb && ha) {
+    res.headline_before = hb->normalized_rmse;
+    res.headline_after = ha->normalized_rmse;
+    res.heldout_rmse_reduction = hb->normalized_rmse > 0 ? 1.0 - ha->normalized_rmse / hb->normalized_rmse : 0.0;
+    for (int c = 0; c < kChannels; ++c)
+      res.explained_share[c] = hb->rmse[c] > 0 ? 1.0 - (ha->rmse[c] / hb->rmse[c]) * (ha->rmse[c] / hb->rmse[c]) : 0.0;
+  }
+  for (const auto& part : o.heldout_recordings) {
+    std::vector<char> mask(d.rows(), 0);
+    for (std::size_t k = 0; k < d.rows(); ++k) mask[k] = held[k] && d.t[k] >= part.t0_s && d.t[k] <= part.t1_s;
+    const auto b = horizon_metrics(nominal_model, d, mask, {o.headline_horizon_s}, 5, o.replay);
+    const auto a = horizon_metrics(corrected, d, mask, {o.headline_horizon_s}, 5, o.replay);
+    if (!b.empty() && !a.empty()) res.per_recording.push_back({part.name, b[0].normalized_rmse, a[0].normalized_rmse});
+  }
+  // What is left: the corrected model's residuals, located on the held-out part.
+  const ResidualSeries rs_after = residual_series(corrected, d, o.locate_horizon_s, o.replay);
+  res.remaining = locate(d, rs_after, held);
+
+  // 3. Model file.
+  CorrectedModelFile file = nominal.file(res.selection.final_effects, res.selection.selected);
+  // The controller has no clock of the recording: a grip change is written as the grip after it.
+  if (file.effects.grip_change_time_s > 0 && file.effects.grip_scale != 1.0) {
+    file.effects.grip_change_time_s = 0.0;
+  }
+  if (!o.out_dir.empty()) std::filesystem::create_directories(o.out_dir);
+  if (!o.out_dir.empty() && !res.selection.reliable) {
+    std::filesystem::remove(o.out_dir + "/corrected_model.yaml");  // none is trusted: none is left behind
+  } else if (!o.out_dir.empty()) {
+    res.model_file = o.out_dir + "/corrected_model.yaml";
+    std::ofstream mf(res.model_file);
+    if (!mf) throw Error("cannot write " + res.model_file);
+    mf << corrected_model_to_yaml(file, "corrected model written by mppi-fit diagnose from " + d.source +
+                                            "\nload with: mppi-sim --model corrected --model-params <this file>");
+  }
+
+  // JSON.
+  json j;
+  j["log"] = d.source;
+  j["model"] = nominal.name();
+  j["params"] = o.params_source;
+  j["rows"] = d.rows();
+  j["control_loss_rows"] = res.control_loss_rows;
+  j["dt_s"] = d.dt_s;
+  j["holdout"] = o.holdout;
+  j["screening"] = screening_json(d);
+  j["selected"] = res.selection.selected;
+  j["reliable"] = res.selection.reliable;
+  j["verdict"] = res.selection.verdict;
+  j["sensor_faults"] = json::array();
+  for (const auto& id : res.selection.selected)
+    if (effect_spec(id).hook == EffectHook::kSensor) j["sensor_faults"].push_back(id);
+  json suspected = json::array();
+  for (const auto& s : res.selection.suspected) {
+    json ps;
+    for (const auto& p : s.params) ps[p.name] = {{"value", num(p.value)}, {"unit", p.unit}};
+    suspected.push_back({{"id", s.id}, {"reason", s.reason}, {"params", ps}});
+  }
+  j["suspected"] = suspected;
+  j["heldout_1s_normalized_rmse"] = {{"nominal", num(res.selection.heldout_nominal)},
+                                     {"corrected", num(res.selection.heldout_corrected)}};
+  json effects = json::array();
+  for (const auto& c : res.selection.candidates) {
+    json e;
+    e["id"] = c.id;
+    if (!c.joint_of.empty()) e["joint_of"] = c.joint_of;
+    json ps;
+    for (const auto& p : c.params) ps[p.name] = {{"value", num(p.value)}, {"stddev", num(p.stddev)}, {"unit", p.unit}};
+    e["params"] = ps;
+    e["validation_improvement"] = num(c.val_improvement);
+    e["bic_delta"] = num(c.bic_delta);
+    e["heldout_improvement"] = num(c.heldout_improvement);
+    e["selected"] = c.selected;
+    if (c.selected) e["round"] = c.round_selected;
+    if (!c.not_testable.empty()) e["not_testable"] = c.not_testable;
+    if (c.inclusion_frequency >= 0) e["inclusion_frequency"] = c.inclusion_frequency;
+    effects.push_back(e);
+  }
+  j["effects"] = effects;
+  json fp;
+  for (const auto& p : res.selection.final_params)
+    fp[p.name] = {{"value", num(p.value)}, {"stddev", num(p.stddev)}, {"unit", p.unit}};
+  j["final_params"] = fp;
+  json mm = json::array();
+  for (const auto& m : res.mismatch)
+    mm.push_back({{"channel", m.channel}, {"where", m.where}, {"magnitude", num(m.magnitude)},
+                  {"rms", num(m.rms)}, {"z", num(m.z)}, {"unit", m.unit}});
+  j["mismatch"] = mm;
+  auto fit_map = [&](const std::vector<HorizonMetrics>& ms) {
+    json f;
+    for (const auto& m : ms) {
+      char key[32];
+      std::snprintf(key, sizeof key, "%s", std::abs(m.horizon_s - d.dt_s) < 1e-9 ? "one_step" : "");
+      std::string k = key[0] ? key : (std::to_string(m.horizon_s).substr(0, 4) + "s");
+      for (int c = 0; c < kChannels; ++c) f[k][kChannelNames[c]] = num(m.fit_percent[c]);
+    }
+    return f;
+  };
+  auto rmse_map = [&](const std::vector<HorizonMetrics>& ms) {
+    json f;
+    for (const auto& m : ms) {
+      std::string k = std::abs(m.horizon_s - d.dt_s) < 1e-9 ? "one_step" : (std::to_string(m.horizon_s).substr(0, 4) + "s");
+      for (int c = 0; c < kChannels; ++c) f[k][kChannelNames[c]] = num(m.rmse[c]);
+      f[k]["normalized"] = num(m.normalized_rmse);
+    }
+    return f;
+  };
+  j["fit_before"] = fit_map(res.before);
+  j["fit_after"] = fit_map(res.after);
+  j["heldout_rmse_before"] = rmse_map(res.before);
+  j["heldout_rmse_after"] = rmse_map(res.after);
+  j["headline"] = {{"horizon_s", o.headline_horizon_s},
+                   {"normalized_rmse_before", num(res.headline_before)},
+                   {"normalized_rmse_after", num(res.headline_after)},
+                   {"reduction", num(res.heldout_rmse_reduction)}};
+  for (int c = 0; c < kChannels; ++c) j["explained_share"][kChannelNames[c]] = num(res.explained_share[c]);
+  json left = json::array();
+  for (const auto& m : res.remaining)
+    left.push_back({{"channel", m.channel}, {"where", m.where}, {"magnitude", num(m.magnitude)},
+                    {"rms", num(m.rms)}, {"z", num(m.z)}, {"unit", m.unit}});
+  j["remaining"] = left;
+  json parts = json::array();
+  for (const auto& p : res.per_recording)
+    parts.push_back({{"recording", p.name}, {"normalized_rmse_before", num(p.before)}, {"normalized_rmse_after", num(p.after)},
+                     {"reduction", num(p.before > 0 ? 1.0 - p.after / p.before : 0.0)}});
+  j["per_recording"] = parts;
+  j["metrics_before"] = metrics_json(res.before);
+  j["metrics_after"] = metrics_json(res.after);
+  j["selection_log"] = res.selection.log;
+  j["model_file"] = res.model_file;
+  // The report's figures: the same data in report.json, the PNGs and report.html.
+  std::optional<plot::Figure> regime_fig, overlay_fig;
+  if (!o.out_dir.empty() && o.plots) {
+    regime_fig = residual_vs_regime_figure(d, rs, rs_after, held);
+    overlay_fig = overlay_figure(d, nominal_model, corrected, held, o.replay);
+    j["figures"] = {{"residual_vs_regime", plot::figure_to_json(*regime_fig)},
+                    {"overlay", plot::figure_to_json(*overlay_fig)}};
+  }
+  res.json = j.dump(2);
+
+  if (!o.out_dir.empty()) {
+    std::ofstream(o.out_dir + "/report.json") << res.json << "\n";
+    // Markdown.
+    std::ostringstream md;
+    md.precision(4);
+    md << "# Sim-vs-real diagnosis\n\n"
+       << "- recording: `" << d.source << "` (" << d.rows() << " rows, dt " << d.dt_s << " s), held out: `" << o.holdout
+       << "`\n- nominal model: " << nominal.name() << (o.params_source.empty() ? " (library defaults)" : " from `" + o.params_source + "`")
+       << "\n- corrected model: " << (res.model_file.empty() ? std::string("none written") : "`" + res.model_file + "`")
+       << "\n- verdict: **" << res.selection.verdict << "**\n\n";
+    if (!d.flags.empty()) {
+      md << "## Screened values (kept out of the fits)\n\n" << d.flags.size() << " values flagged; "
+         << d.screened_rows << " rows dropped with their neighbours.\n\n| file | row | t [s] | column | value | kind |\n|---|---|---|---|---|---|\n";
+      for (std::size_t i = 0; i < d.flags.size() && i < kMaxListedFlags; ++i) {
+        const ScreenFlag& f = d.flags[i];
+        md << "| " << f.file << " | " << f.row << " | " << f.t_s << " | " << f.column << " | " << f.value << " | " << f.kind << " |\n";
+      }
+      if (d.flags.size() > kMaxListedFlags) md << "\n(first " << kMaxListedFlags << " listed; all in the counts)\n";
+      md << "\n";
+    }
+    md << "## Named effects\n\n";
+    auto inclusion = [&](const std::string& id) {
+      for (const auto& c : res.selection.candidates)
+        if (c.id == id && c.inclusion_frequency >= 0) return " (chosen in " + std::to_string(std::lround(100 * c.inclusion_frequency)) + " % of resamples)";
+      return std::string();
+    };
+    int physics = 0, sensors = 0;
+    for (const auto& id : res.selection.selected) (effect_spec(id).hook == EffectHook::kSensor ? sensors : physics)++;
+    if (physics == 0) md << "No missing physics named.\n";
+    for (const auto& id : res.selection.selected)
+      if (effect_spec(id).hook != EffectHook::kSensor) md << "- **" << id << "**: " << effect_spec(id).description << inclusion(id) << "\n";
+    if (sensors > 0) {
+      md << "\n## Sensor faults (what the recording shows, not the car)\n\n";
+      for (const auto& id : res.selection.selected)
+        if (effect_spec(id).hook == EffectHook::kSensor) md << "- **" << id << "**: " << effect_spec(id).description << inclusion(id) << "\n";
+    }
+    if (!res.selection.suspected.empty()) {
+      md << "\n## Suspected, not identifiable from this recording\n\n| effect | why not named | fitted |\n|---|---|---|\n";
+      for (const auto& s : res.selection.suspected) {
+        md << "| " << s.id << " | " << s.reason << " | ";
+        for (const auto& p : s.params) md << p.name << " = " << p.value << "; ";
+        md << " |\n";
+      }
+    }
+    md << "\nFinal parameters (joint refit, 1-sigma):\n\n| parameter | value | stddev | unit |\n|---|---|---|---|\n";
+    for (const auto& p : res.selection.final_params)
+      md << "| " << p.name << " | " << p.value << " | " << p.stddev << " | " << p.unit << " |\n";
+    md << "\n## Where the nominal model is wrong (training part, " << rs.horizon_s
+       << " s predictions, acceleration error)\n\n| channel | where | mean | rms | z |\n|---|---|---|---|---|\n";
+    for (std::size_t i = 0; i < res.mismatch.size() && i < 25; ++i) {
+      const auto& m = res.mismatch[i];
+      md << "| " << m.channel << " | " << m.where << " | " << m.magnitude << " " << m.unit << " | " << m.rms << " | " << m.z << " |\n";
+    }
+    md << "\n## Candidates (each alone on the nominal model)\n\n| effect | params | validation improvement | dBIC | held-out improvement | inclusion | selected |\n|---|---|---|---|---|---|---|\n";
+    for (const auto& c : res.selection.candidates) {
+      if (!c.not_testable.empty()) {
+        md << "| " << c.id << " | not testable: " << c.not_testable << " | | | | | |\n";
+        continue;
+      }
+      md << "| " << c.id << " | ";
+      for (const auto& p : c.params) md << p.name << " = " << p.value << " +- " << p.stddev << "; ";
+      md << " | " << 100 * c.val_improvement << " % | " << c.bic_delta << " | " << 100 * c.heldout_improvement << " % | "
+         << (c.inclusion_frequency >= 0 ? std::to_string(std::lround(100 * c.inclusion_frequency)) + " %" : "") << " | "
+         << (c.selected ? "yes" : "") << " |\n";
+    }
+    md << "\n## Held-out fit before -> after\n\n| horizon | channel | fit % before | fit % after | RMSE before | RMSE after |\n|---|---|---|---|---|---|\n";
+    for (std::size_t i = 0; i < res.before.size(); ++i)
+      for (int c = 0; c < kChannels; ++c)
+        md << "| " << res.before[i].horizon_s << " s | " << kChannelNames[c] << " | " << res.before[i].fit_percent[c] << " | "
+           << res.after[i].fit_percent[c] << " | " << res.before[i].rmse[c] << " | " << res.after[i].rmse[c] << " " << kChannelUnits[c] << " |\n";
+    md << "\nHeadline: normalised multi-step RMSE at " << o.headline_horizon_s << " s: " << res.headline_before << " -> "
+       << res.headline_after << " (" << 100 * res.heldout_rmse_reduction << " % reduction).\n\n"
+       << [&] {
+            if (res.per_recording.empty()) return std::string();
+            std::ostringstream t;
+            t.precision(4);
+            t << "Per held-out recording (normalised RMSE at " << o.headline_horizon_s
+              << " s):\n\n| recording | nominal | corrected | reduction |\n|---|---|---|---|\n";
+            for (const auto& p : res.per_recording)
+              t << "| `" << p.name << "` | " << p.before << " | " << p.after << " | "
+                << 100 * (p.before > 0 ? 1.0 - p.after / p.before : 0.0) << " % |\n";
+            return t.str() + "\n";
+          }()
+       << "## What is left\n\nShare of the held-out squared error at " << o.headline_horizon_s
+       << " s that the correction explains:";
+    for (int c = 0; c < kChannels; ++c) md << " " << kChannelNames[c] << " " << 100 * res.explained_share[c] << " %" << (c + 1 < kChannels ? "," : ".");
+    md << "\n\n";
+    if (res.remaining.empty()) {
+      md << "The corrected model's residuals on the held-out part show no bias by channel, regime, place or time (|z| < 4).\n\n";
+    } else {
+      md << "Where the corrected model is still wrong (held-out part):\n\n| channel | where | mean | rms | z |\n|---|---|---|---|---|\n";
+      for (std::size_t i = 0; i < res.remaining.size() && i < 10; ++i) {
+        const auto& m = res.remaining[i];
+        md << "| " << m.channel << " | " << m.where << " | " << m.magnitude << " " << m.unit << " | " << m.rms << " | " << m.z << " |\n";
+      }
+      md << "\n";
+    }
+    md
+       << "![residual vs regime](residual_vs_regime.png)\n\n![overlay](overlay.png)\n\n## Selection log\n\n```\n";
+    for (const auto& l : res.selection.log) md << l << "\n";
+    md << "```\n";
+    std::ofstream(o.out_dir + "/report.md") << md.str();
+    if (o.plots) {
+      regime_fig->write_png(o.out_dir + "/residual_vs_regime.png");
+      overlay_fig->write_png(o.out_dir + "/overlay.png");
+      plot::write_html_report(o.out_dir + "/report.html", "Sim-vs-real diagnosis", md.str(),
+                              {{"residual_vs_regime.png", j["figures"]["residual_vs_regime"]},
+                               {"overlay.png", j["figures"]["overlay"]}});
+    }
+  }
+  return res;
+}
+
+}  // namespace mppi::diagnose
