@@ -6,7 +6,7 @@
 #
 #   scripts/docs_figures.sh           # all but the Vulkan run (about 10 min on 2 loaded cores)
 #   scripts/docs_figures.sh --vulkan  # also the 5 Vulkan laps (lavapipe: ~280 ms a step, ~15 min more)
-#   scripts/docs_figures.sh --diagnose-docs  # also rewrite docs/diagnose/dart (report and figures)
+#   scripts/docs_figures.sh --diagnose-docs  # also rewrite results/diagnose/dart (report and figures)
 #
 # Needs build/bin/mppi-sim and build/bin/mppi-fit (scripts/demo.sh or cmake --build build).
 set -euo pipefail
@@ -83,10 +83,10 @@ estimate dart_alm real/dart_jetracer.zip:car_1_Datarecording_09_16_2024_10_27_02
   --measure x,y,yaw,vx,vy,yaw_rate --fit 0:85 --validate 85:105
 
 # The DART sim-vs-real diagnosis (docs/DIAGNOSE.md): report, figures and report.html, written to
-# out/, or into docs/diagnose/dart with --diagnose-docs (the numbers quoted in docs/DIAGNOSE.md
+# out/, or into results/diagnose/dart with --diagnose-docs (the numbers quoted in docs/DIAGNOSE.md
 # and the README come from that report: update them with it).
 dart_out="$out/dart"
-[ "$diagnose_docs" = 1 ] && dart_out=docs/diagnose/dart
+[ "$diagnose_docs" = 1 ] && dart_out=results/diagnose/dart
 echo "[docs_figures] mppi-fit diagnose (DART) -> $dart_out"
 "$bin/mppi-fit" diagnose \
   --log data/real/dart_jetracer.zip:car_1_Datarecording_09_16_2024_10_27_02.csv \
