@@ -348,6 +348,8 @@ TEST_CASE("joined recordings: no rollout spans a seam or starts on one, so a pla
     o.extra_state_columns = {"omega_front", "omega_rear"};
     std::vector<double> x0 = wheels_rolling(SingleTrackParams{}, vx);
     x0.push_back(0.0);  // applied steering
+    x0.push_back(0.0);  // applied throttle (the spec carries both actuator states)
+    REQUIRE(x0.size() == spec.state_names.size());
     sim::Recording r = roll_out_manoeuvres(lagged, x0, o);
     for (auto& col : r.data) col.resize(250);  // the next piece's first row falls on a rollout start (every 25)
     return r;
