@@ -13,8 +13,10 @@
 # - ASan is built by clang with one version of each hot kernel (MPPI_NO_MULTIVERSION): the
 #   AVX-512 / AVX2 / baseline clones are the same source compiled three times, and clang
 #   compiles the template-heavy rollouts in about half GCC's time; together they halve the
-#   build. The [slow] cases (scripts/evidence.sh) are left out: their code runs under ASan in
-#   their fast siblings. LeakSanitizer leaves out what tests/lsan.supp names (fontconfig, the
+#   build. -ffp-contract=off: clang would fuse a * b + c where GCC's baseline build does not
+#   (even when folding constants), and the fast-math tests check exact saturation values.
+#   The [slow] cases (scripts/evidence.sh) are left out: their code runs under ASan in their
+#   fast siblings. LeakSanitizer leaves out what tests/lsan.supp names (fontconfig, the
 #   Vulkan drivers and their LLVM). The Python tests and the programs' command-line tests run
 #   only in the normal build.
 # - TSan: the OpenMP schedules (ThreadSchedule::kDynamic / kStatic). Debian's libgomp is not
@@ -77,7 +79,7 @@ run_tsan() {
 
 case "$which" in
   asan|all)
-    sanitizer_build build-asan clang "-fsanitize=address,undefined -fno-sanitize-recover=all -DMPPI_NO_MULTIVERSION -Wno-pass-failed" \
+    sanitizer_build build-asan clang "-fsanitize=address,undefined -fno-sanitize-recover=all -DMPPI_NO_MULTIVERSION -ffp-contract=off -Wno-pass-failed" \
       mppi-tests mppi-ocs-tests
     run_asan ;;&
   tsan|all)
