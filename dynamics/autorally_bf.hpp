@@ -13,7 +13,8 @@
 // left) into them and the derivative of yaw_mder back. With beta = atan((u_y + 0.45 yaw_mder)
 // / u_x) (the front-axle slip direction), t = tan(beta - u_0), q = (u_y - 0.35 yaw_mder) / u_x:
 //   phi =  throttle, u_x/10, sin(u_0) t/1200, sin(u_0) t|t|/1200^2, sin(u_0) t^3/1200^3 ... (see
-//   basis() below for all 25, in order); below u_x = 0.1 m/s the ratios are replaced by 0.
+//   dynamics/autorally_bf_features.hpp for all 25, in order); below u_x = 0.1 m/s the ratios
+//   are replaced by 0.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -76,31 +77,8 @@ class AutoRallyBasisFunctionModel {
     const float t_abs = t * std::abs(t);
     const float t3 = t * t * t;
     const float q = moving ? (uy - 0.35f * yaw_mder) * inv_ux : 0.f;
-    phi[0] = u1;
-    phi[1] = ux / 10.f;
-    phi[2] = su * t / 1200.f;
-    phi[3] = su * t_abs / 1440000.f;
-    phi[4] = su * t3 / 1728000000.f;
-    phi[5] = yaw_mder * uy / 25.f;
-    phi[6] = yaw_mder / 10.f;
-    phi[7] = uy / 10.f;
-    phi[8] = su;
-    phi[9] = moving ? uy * inv_ux / 40.f : 0.f;
-    phi[10] = t / 1400.f;
-    phi[11] = t_abs / 1960000.f;
-    phi[12] = t3 / 2744000000.f;
-    phi[13] = q / 40.f;
-    phi[14] = q * std::abs(q) / 1600.f;
-    phi[15] = q * q * q / 64000.f;
-    phi[16] = yaw_mder * ux / 50.f;
-    phi[17] = roll;
-    phi[18] = roll * yaw_mder;
-    phi[19] = roll * ux / 3.f;
-    phi[20] = roll * ux * yaw_mder / 5.f;
-    phi[21] = ux * ux / 100.f;
-    phi[22] = ux * ux * ux / 1000.f;
-    phi[23] = u1 * u1;
-    phi[24] = u1 * u1 * u1;
+    using std::abs;  // the float one, for the shared list
+#include "dynamics/autorally_bf_features.hpp"
   }
 
   template <int W>

@@ -182,6 +182,12 @@ template <class T>
 struct FourWheelRates {
   T dvx, dvy, dr, dw0, dw1, dw2, dw3;
 };
+// The rates out of one evaluation's terms.
+template <class T>
+[[gnu::always_inline]] inline FourWheelRates<T> rates_of(const FourWheelTerms<T>& e) noexcept {
+  return {e.dvx_mps2, e.dvy_mps2, e.dyaw_rate_radps2, e.domega_radps2[0], e.domega_radps2[1],
+          e.domega_radps2[2], e.domega_radps2[3]};
+}
 template <class T>
 [[gnu::always_inline]] inline FourWheelRates<T> four_wheel_rates(const FourWheelCoeffs<T>& k, T vx, T vy, T r,
                                                                   T w0, T w1, T w2, T w3, T steer,
@@ -189,8 +195,50 @@ template <class T>
   const T omega[4] = {w0, w1, w2, w3};
   FourWheelTerms<T> e;
   four_wheel_terms<T>(k, vx, vy, r, omega, steer, throttle, nullptr, &e);
-  return {e.dvx_mps2, e.dvy_mps2, e.dyaw_rate_radps2, e.domega_radps2[0], e.domega_radps2[1],
-          e.domega_radps2[2], e.domega_radps2[3]};
+  return rates_of(e);
+}
+
+// The planar rows of a four-wheel batch (pose, body velocities, wheel speeds from row `omega`):
+// what the double-track and the full vehicle step alike.
+template <int W>
+struct FourWheelLanes {
+  float *x, *y, *yaw, *vx, *vy, *yaw_rate, *w0, *w1, *w2, *w3;
+
+  template <int Nx>
+  FourWheelLanes(Batch<Nx, W> b, int omega) noexcept
+      : x(b[state::kX]), y(b[state::kY]), yaw(b[state::kYaw]), vx(b[state::kVx]), vy(b[state::kVy]),
+        yaw_rate(b[state::kYawRate]), w0(b[omega]), w1(b[omega + 1]), w2(b[omega + 2]), w3(b[omega + 3]) {}
+
+  // Explicit Euler of lane j's planar state by the rates d; the pose moves with the old velocities.
+  [[gnu::always_inline]] void advance(int j, const FourWheelRates<float>& d, float dt_s) const noexcept {
+    const float u = vx[j], v = vy[j], r = yaw_rate[j];
+    float sy, cy;
+    fast_sincos(yaw[j], &sy, &cy);
+    x[j] += (cy * u - sy * v) * dt_s;
+    y[j] += (sy * u + cy * v) * dt_s;
+    yaw[j] += r * dt_s;
+    vx[j] = u + d.dvx * dt_s;
+    vy[j] = v + d.dvy * dt_s;
+    yaw_rate[j] = r + d.dr * dt_s;
+    w0[j] += d.dw0 * dt_s;
+    w1[j] += d.dw1 * dt_s;
+    w2[j] += d.dw2 * dt_s;
+    w3[j] += d.dw3 * dt_s;
+  }
+};
+
+// dx = f(x, u) of the planar rows (all but roll and what follows the wheel speeds at `omega`),
+// in double, from one evaluation's terms.
+inline void four_wheel_planar_derivatives(const double* x, const FourWheelTerms<double>& e, int omega,
+                                          double* dx) noexcept {
+  const double sy = std::sin(x[state::kYaw]), cy = std::cos(x[state::kYaw]);
+  dx[state::kX] = cy * x[state::kVx] - sy * x[state::kVy];
+  dx[state::kY] = sy * x[state::kVx] + cy * x[state::kVy];
+  dx[state::kYaw] = x[state::kYawRate];
+  dx[state::kVx] = e.dvx_mps2;
+  dx[state::kVy] = e.dvy_mps2;
+  dx[state::kYawRate] = e.dyaw_rate_radps2;
+  for (int i = 0; i < 4; ++i) dx[omega + i] = e.domega_radps2[i];
 }
 
 inline FourWheelCoeffs<double> double_track_coeffs(const DoubleTrackParams& p) noexcept {
@@ -221,35 +269,14 @@ class DoubleTrack {
   template <int W>
   void step(Batch<kNx, W> x, ConstBatch<kNu, W> u, float dt_s, float* /*scratch*/) const noexcept {
     const FourWheelCoeffs<float> k = kf_;
-    float* px = x[state::kX];
-    float* py = x[state::kY];
-    float* pyaw = x[state::kYaw];
-    float* pvx = x[state::kVx];
-    float* pvy = x[state::kVy];
-    float* pr = x[state::kYawRate];
-    float* pw0 = x[kOmega];
-    float* pw1 = x[kOmega + 1];
-    float* pw2 = x[kOmega + 2];
-    float* pw3 = x[kOmega + 3];
+    const FourWheelLanes<W> p(x, kOmega);
     const float* ps = u[control::kSteer];
     const float* pt = u[control::kThrottle];
     MPPI_SIMD_LOOP
     for (int j = 0; j < W; ++j) {
-      const float vx = pvx[j], vy = pvy[j], r = pr[j];
-      const FourWheelRates<float> d =
-          four_wheel_rates<float>(k, vx, vy, r, pw0[j], pw1[j], pw2[j], pw3[j], ps[j], pt[j]);
-      float sy, cy;
-      fast_sincos(pyaw[j], &sy, &cy);
-      px[j] += (cy * vx - sy * vy) * dt_s;
-      py[j] += (sy * vx + cy * vy) * dt_s;
-      pyaw[j] += r * dt_s;
-      pvx[j] = vx + d.dvx * dt_s;
-      pvy[j] = vy + d.dvy * dt_s;
-      pr[j] = r + d.dr * dt_s;
-      pw0[j] += d.dw0 * dt_s;
-      pw1[j] += d.dw1 * dt_s;
-      pw2[j] += d.dw2 * dt_s;
-      pw3[j] += d.dw3 * dt_s;
+      const FourWheelRates<float> d = four_wheel_rates<float>(k, p.vx[j], p.vy[j], p.yaw_rate[j], p.w0[j],
+                                                              p.w1[j], p.w2[j], p.w3[j], ps[j], pt[j]);
+      p.advance(j, d, dt_s);
     }
   }
 
@@ -272,15 +299,8 @@ class DoubleTrack {
     FourWheelTerms<double> e;
     four_wheel_terms<double>(k, x[state::kVx], x[state::kVy], x[state::kYawRate], x + kOmega,
                              u[control::kSteer], u[control::kThrottle], nullptr, &e);
-    const double sy = std::sin(x[state::kYaw]), cy = std::cos(x[state::kYaw]);
-    dx[state::kX] = cy * x[state::kVx] - sy * x[state::kVy];
-    dx[state::kY] = sy * x[state::kVx] + cy * x[state::kVy];
-    dx[state::kYaw] = x[state::kYawRate];
-    dx[state::kVx] = e.dvx_mps2;
-    dx[state::kVy] = e.dvy_mps2;
-    dx[state::kYawRate] = e.dyaw_rate_radps2;
+    four_wheel_planar_derivatives(x, e, kOmega, dx);
     dx[state::kRoll] = 0.0;
-    for (int i = 0; i < 4; ++i) dx[kOmega + i] = e.domega_radps2[i];
   }
 
   // Tyre velocities, slips, loads and forces at (x, u), in double.

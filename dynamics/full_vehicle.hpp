@@ -117,7 +117,8 @@ template <class T>
 // The rates the batched step needs, from scalars (keeps arrays out of the omp-simd loop body).
 template <class T>
 struct FullVehicleRates {
-  T dvx, dvy, dr, dw0, dw1, dw2, dw3, droll_rate, dpitch_rate, dheave_rate;
+  FourWheelRates<T> planar;
+  T droll_rate, dpitch_rate, dheave_rate;
 };
 template <class T>
 [[gnu::always_inline]] inline FullVehicleRates<T> full_vehicle_rates(
@@ -127,9 +128,7 @@ template <class T>
   FullVehicleTerms<T> e;
   full_vehicle_terms<T>(k, vx, vy, r, omega, roll, pitch, heave, roll_rate, pitch_rate, heave_rate,
                         steer, throttle, &e);
-  return {e.planar.dvx_mps2, e.planar.dvy_mps2, e.planar.dyaw_rate_radps2,
-          e.planar.domega_radps2[0], e.planar.domega_radps2[1], e.planar.domega_radps2[2],
-          e.planar.domega_radps2[3], e.droll_rate_radps2, e.dpitch_rate_radps2, e.dheave_rate_mps2};
+  return {rates_of(e.planar), e.droll_rate_radps2, e.dpitch_rate_radps2, e.dheave_rate_mps2};
 }
 
 class FullVehicle {
@@ -157,17 +156,8 @@ class FullVehicle {
   template <int W>
   void step(Batch<kNx, W> x, ConstBatch<kNu, W> u, float dt_s, float* /*scratch*/) const noexcept {
     const FullVehicleCoeffs<float> k = kf_;
-    float* px = x[state::kX];
-    float* py = x[state::kY];
-    float* pyaw = x[state::kYaw];
-    float* pvx = x[state::kVx];
-    float* pvy = x[state::kVy];
-    float* pr = x[state::kYawRate];
+    const FourWheelLanes<W> p(x, kOmega);
     float* proll = x[state::kRoll];
-    float* pw0 = x[kOmega];
-    float* pw1 = x[kOmega + 1];
-    float* pw2 = x[kOmega + 2];
-    float* pw3 = x[kOmega + 3];
     float* ppitch = x[kPitch];
     float* pz = x[kHeave];
     float* proll_rate = x[kRollRate];
@@ -177,22 +167,10 @@ class FullVehicle {
     const float* pt = u[control::kThrottle];
     MPPI_SIMD_LOOP
     for (int j = 0; j < W; ++j) {
-      const float vx = pvx[j], vy = pvy[j], r = pr[j];
-      const FullVehicleRates<float> e =
-          full_vehicle_rates<float>(k, vx, vy, r, pw0[j], pw1[j], pw2[j], pw3[j], proll[j], ppitch[j],
-                                    pz[j], proll_rate[j], ppitch_rate[j], pz_rate[j], ps[j], pt[j]);
-      float sy, cy;
-      fast_sincos(pyaw[j], &sy, &cy);
-      px[j] += (cy * vx - sy * vy) * dt_s;
-      py[j] += (sy * vx + cy * vy) * dt_s;
-      pyaw[j] += r * dt_s;
-      pvx[j] = vx + e.dvx * dt_s;
-      pvy[j] = vy + e.dvy * dt_s;
-      pr[j] = r + e.dr * dt_s;
-      pw0[j] += e.dw0 * dt_s;
-      pw1[j] += e.dw1 * dt_s;
-      pw2[j] += e.dw2 * dt_s;
-      pw3[j] += e.dw3 * dt_s;
+      const FullVehicleRates<float> e = full_vehicle_rates<float>(
+          k, p.vx[j], p.vy[j], p.yaw_rate[j], p.w0[j], p.w1[j], p.w2[j], p.w3[j], proll[j], ppitch[j], pz[j],
+          proll_rate[j], ppitch_rate[j], pz_rate[j], ps[j], pt[j]);
+      p.advance(j, e.planar, dt_s);
       const float roll_rate = proll_rate[j] + e.droll_rate * dt_s;
       const float pitch_rate = ppitch_rate[j] + e.dpitch_rate * dt_s;
       const float heave_rate = pz_rate[j] + e.dheave_rate * dt_s;
@@ -221,15 +199,8 @@ class FullVehicle {
   static void derivatives(const FullVehicleCoeffs<double>& k, const double* x, const double* u,
                           double* dx) noexcept {
     const FullVehicleTerms<double> e = terms(k, x, u);
-    const double sy = std::sin(x[state::kYaw]), cy = std::cos(x[state::kYaw]);
-    dx[state::kX] = cy * x[state::kVx] - sy * x[state::kVy];
-    dx[state::kY] = sy * x[state::kVx] + cy * x[state::kVy];
-    dx[state::kYaw] = x[state::kYawRate];
-    dx[state::kVx] = e.planar.dvx_mps2;
-    dx[state::kVy] = e.planar.dvy_mps2;
-    dx[state::kYawRate] = e.planar.dyaw_rate_radps2;
+    four_wheel_planar_derivatives(x, e.planar, kOmega, dx);
     dx[state::kRoll] = x[kRollRate];
-    for (int i = 0; i < 4; ++i) dx[kOmega + i] = e.planar.domega_radps2[i];
     dx[kPitch] = x[kPitchRate];
     dx[kHeave] = x[kHeaveRate];
     dx[kRollRate] = e.droll_rate_radps2;

@@ -16,16 +16,21 @@
 //   static std::vector<GpuField<Model>> gpu_fields();
 //   static bool gpu_tail(const Model&, GpuTail& tail, std::string* why);   (optional: arrays
 //                                                   after the named floats, shader constants)
-// The line MPPI_REGISTER_MODEL(Descriptor) in the header enters it into the compile-time list of
-// models (<build>/generated/dynamics/model_list.hpp, collected by the build from
-// dynamics/models/*.hpp).
+// A descriptor may take the usual parts from ParamTableDescriptor or WeightsFileDescriptor
+// below by deriving from it. The line MPPI_REGISTER_MODEL(Descriptor) in the header enters it
+// into the compile-time list of models (<build>/generated/dynamics/model_list.hpp, collected by
+// the build from dynamics/models/*.hpp).
+#include <algorithm>
 #include <concepts>
+#include <initializer_list>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "base/error.hpp"
 #include "base/param_table.hpp"
 #include "mppi/concepts.hpp"
+#include "mppi/vehicle_state.hpp"
 
 namespace mppi {
 
@@ -77,6 +82,40 @@ concept HasGpuTail = requires(const typename D::Model& m, GpuTail& t, std::strin
 inline std::vector<std::string> common_state_names() {
   return {"x_m", "y_m", "yaw_rad", "vx_mps", "vy_mps", "yaw_rate_radps", "roll_rad"};
 }
+
+// The common state names followed by a model's own states.
+inline std::vector<std::string> common_state_names_and(std::initializer_list<std::string> own) {
+  std::vector<std::string> names = common_state_names();
+  names.insert(names.end(), own);
+  return names;
+}
+
+// The descriptor part of a model built from a YAML parameter table P (param_table(P&)): make()
+// from parameters, load() from a file through `load_params` ("" = the built-in defaults).
+template <class M, class P, P (*load_params)(const std::string&)>
+struct ParamTableDescriptor {
+  using Model = M;
+  using Params = P;
+  static std::vector<ParamField> params(Params& p) { return param_table(p); }
+  static Model make(const Params& p) { return Model(p); }
+  static Model load(const std::string& path) { return Model(path.empty() ? Params{} : load_params(path)); }
+};
+
+// The descriptor part of a learned model: M::load reads its weights file, which has no built-in
+// default; its state is the common state, copied from any plant. Self: the descriptor (its kName
+// names the model in the error).
+template <class Self, class M>
+struct WeightsFileDescriptor {
+  using Model = M;
+  static Model load(const std::string& path) {
+    if (path.empty()) throw Error(std::string("the ") + Self::kName + " model needs its weights file (npz)");
+    return Model::load(path);
+  }
+  static std::vector<std::string> state_names() { return common_state_names(); }
+  static void from_plant(const Model&, const float* px, int, float* mx) {
+    std::copy(px, px + state::kCommonStates, mx);
+  }
+};
 
 }  // namespace mppi
 

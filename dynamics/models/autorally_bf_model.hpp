@@ -1,28 +1,17 @@
 #pragma once
 // AutoRally's basis-function model (dynamics/autorally_bf.hpp) as the registry knows it.
-#include <algorithm>
 #include <string>
 #include <vector>
 
-#include "base/error.hpp"
 #include "dynamics/autorally_bf.hpp"
 #include "dynamics/model_descriptor.hpp"
 
 namespace mppi::models {
 
-struct AutoRallyBasisFunctions {
-  using Model = AutoRallyBasisFunctionModel;
+struct AutoRallyBasisFunctions : WeightsFileDescriptor<AutoRallyBasisFunctions, AutoRallyBasisFunctionModel> {
   static constexpr const char* kName = "autorally-bf";
   static constexpr const char* kSummary = "the AutoRally car's basis-function model (25 hand-made features, fitted weights)";
   static constexpr const char* kDefaultFile = "autorally/models/basis_function_09_12_2018.npz";
-  static Model load(const std::string& path) {
-    if (path.empty()) throw Error("the autorally-bf model needs its weights file (npz)");
-    return Model::load(path);
-  }
-  static std::vector<std::string> state_names() { return common_state_names(); }
-  static void from_plant(const Model&, const float* px, int, float* mx) {
-    std::copy(px, px + state::kCommonStates, mx);
-  }
 
   // GPU twin: vulkan/shaders/models/autorally_bf.glsl reads W (4 x 25, row-major) after the
   // named floats.

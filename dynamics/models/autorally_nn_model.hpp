@@ -1,29 +1,18 @@
 #pragma once
 // The AutoRally neural network (dynamics/autorally_nn.hpp) as the registry knows it.
-#include <algorithm>
 #include <cstddef>
 #include <string>
 #include <vector>
 
-#include "base/error.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/model_descriptor.hpp"
 
 namespace mppi::models {
 
-struct AutoRallyNetworkModel {
-  using Model = AutoRallyNetwork;
+struct AutoRallyNetworkModel : WeightsFileDescriptor<AutoRallyNetworkModel, AutoRallyNetwork> {
   static constexpr const char* kName = "autorally-nn";
   static constexpr const char* kSummary = "the AutoRally car's neural network (6-32-32-4, tanh), learned from real driving";
   static constexpr const char* kDefaultFile = "autorally/models/autorally_nnet_09_12_2018.npz";
-  static Model load(const std::string& path) {
-    if (path.empty()) throw Error("the autorally-nn model needs its weights file (npz)");
-    return Model::load(path);
-  }
-  static std::vector<std::string> state_names() { return common_state_names(); }
-  static void from_plant(const Model&, const float* px, int, float* mx) {
-    std::copy(px, px + state::kCommonStates, mx);
-  }
 
   // GPU twin: vulkan/shaders/models/autorally_nn.glsl, a 6-H1-H2-4 tanh-tanh-linear MLP. Each
   // layer as W with every row padded to a multiple of 4 floats, then b padded to a multiple of

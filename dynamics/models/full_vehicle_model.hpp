@@ -11,26 +11,12 @@
 
 namespace mppi::models {
 
-struct FullVehicleModel {
-  using Model = FullVehicle;
-  using Params = FullVehicleParams;
+struct FullVehicleModel : FourWheelDescriptor<FullVehicle, FullVehicleParams, load_full_vehicle_params> {
   static constexpr const char* kName = "full-vehicle";
   static constexpr const char* kSummary = "full vehicle: four wheels, sprung mass in heave, roll and pitch, aero drag";
   static constexpr const char* kDefaultFile = "config/autorally_full_vehicle.yaml";
-  static std::vector<ParamField> params(Params& p) { return param_table(p); }
-  static Model make(const Params& p) { return Model(p); }
-  static Model load(const std::string& path) {
-    return Model(path.empty() ? Params{} : load_full_vehicle_params(path));
-  }
   static std::vector<std::string> state_names() {
-    auto names = common_state_names();
-    names.insert(names.end(), {"omega_lf_radps", "omega_rf_radps", "omega_lr_radps", "omega_rr_radps",
-                               "pitch_rad", "heave_m", "roll_rate_radps", "pitch_rate_radps",
-                               "heave_rate_mps"});
-    return names;
-  }
-  static void from_plant(const Model& m, const float* px, int plant_states, float* mx) {
-    four_wheel_from_plant<Model>(px, plant_states, static_cast<float>(m.params().base.wheel_radius_m), mx);
+    return four_wheel_state_names({"pitch_rad", "heave_m", "roll_rate_radps", "pitch_rate_radps", "heave_rate_mps"});
   }
 };
 MPPI_REGISTER_MODEL(FullVehicleModel);

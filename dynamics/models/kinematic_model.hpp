@@ -11,17 +11,10 @@
 
 namespace mppi::models {
 
-struct Kinematic {
-  using Model = KinematicBicycle;
-  using Params = KinematicBicycleParams;
+struct Kinematic : ParamTableDescriptor<KinematicBicycle, KinematicBicycleParams, load_kinematic_bicycle_params> {
   static constexpr const char* kName = "kinematic";
   static constexpr const char* kSummary = "kinematic bicycle (no tyre slip), reference point at the rear axle";
   static constexpr const char* kDefaultFile = "";
-  static std::vector<ParamField> params(Params& p) { return param_table(p); }
-  static Model make(const Params& p) { return Model(p); }
-  static Model load(const std::string& path) {
-    return Model(path.empty() ? Params{} : load_kinematic_bicycle_params(path));
-  }
   static std::vector<std::string> state_names() { return common_state_names(); }
   // The kinematic bicycle's reference point is the rear axle, l_r behind a physics plant's CG.
   static void from_plant(const Model&, const float* px, int, float* mx) {

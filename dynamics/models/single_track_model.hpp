@@ -11,21 +11,12 @@
 
 namespace mppi::models {
 
-struct SingleTrackModel {
-  using Model = SingleTrack;
-  using Params = SingleTrackParams;
+struct SingleTrackModel : ParamTableDescriptor<SingleTrack, SingleTrackParams, load_single_track_params> {
   static constexpr const char* kName = "single-track";
   static constexpr const char* kSummary = "single-track physics: Pacejka tyres, wheel spin, load transfer, DC-motor drive";
   static constexpr const char* kDefaultFile = "config/autorally_single_track.yaml";
-  static std::vector<ParamField> params(Params& p) { return param_table(p); }
-  static Model make(const Params& p) { return Model(p); }
-  static Model load(const std::string& path) {
-    return Model(path.empty() ? Params{} : load_single_track_params(path));
-  }
   static std::vector<std::string> state_names() {
-    auto names = common_state_names();
-    names.insert(names.end(), {"omega_front_radps", "omega_rear_radps"});
-    return names;
+    return common_state_names_and({"omega_front_radps", "omega_rear_radps"});
   }
   // The same model's state is copied whole; another plant's wheels roll at v_x / R.
   static void from_plant(const Model& m, const float* px, int plant_states, float* mx) {

@@ -2,7 +2,8 @@
 // d/dt [roll, u_x, u_y, yaw_mder] = W phi(s, u) with the 25 basis functions in AutoRally's
 // conventions (yaw_mder = minus the yaw rate, steering positive right). NX and P_MODEL_TAIL
 // come from the generated layout_autorally_bf.glsl; W (4 x 25, row-major) starts at
-// P_MODEL_TAIL. Every loop has a compile-time trip count and is unrolled.
+// P_MODEL_TAIL. Every loop has a compile-time trip count and is unrolled. The basis functions
+// themselves are the C++ model's list (dynamics/autorally_bf_features.hpp).
 #define BF_COUNT 25
 
 void bf_basis(float roll, float ux, float uy, float yaw_mder, float u0, float u1, out float phi[BF_COUNT]) {
@@ -16,31 +17,7 @@ void bf_basis(float roll, float ux, float uy, float yaw_mder, float u0, float u1
   precise float t_abs = t * abs(t);
   precise float t3 = t * t * t;
   precise float q = moving ? (uy - 0.35 * yaw_mder) * inv_ux : 0.0;
-  phi[0] = u1;
-  phi[1] = ux / 10.0;
-  phi[2] = su * t / 1200.0;
-  phi[3] = su * t_abs / 1440000.0;
-  phi[4] = su * t3 / 1728000000.0;
-  phi[5] = yaw_mder * uy / 25.0;
-  phi[6] = yaw_mder / 10.0;
-  phi[7] = uy / 10.0;
-  phi[8] = su;
-  phi[9] = moving ? uy * inv_ux / 40.0 : 0.0;
-  phi[10] = t / 1400.0;
-  phi[11] = t_abs / 1960000.0;
-  phi[12] = t3 / 2744000000.0;
-  phi[13] = q / 40.0;
-  phi[14] = q * abs(q) / 1600.0;
-  phi[15] = q * q * q / 64000.0;
-  phi[16] = yaw_mder * ux / 50.0;
-  phi[17] = roll;
-  phi[18] = roll * yaw_mder;
-  phi[19] = roll * ux / 3.0;
-  phi[20] = roll * ux * yaw_mder / 5.0;
-  phi[21] = ux * ux / 100.0;
-  phi[22] = ux * ux * ux / 1000.0;
-  phi[23] = u1 * u1;
-  phi[24] = u1 * u1 * u1;
+#include "dynamics/autorally_bf_features.hpp"
 }
 
 void model_step(inout float x[NX], float steer, float throttle, float dt) {
