@@ -400,20 +400,13 @@ void register_sysid(py::module_& m) {
     py::list rows;
     for (const BifilarRow& r : autorally_bifilar_table()) {
       const BifilarCheck c = check_bifilar_row(r, g);
-      py::dict d;
-      d["axis"] = r.axis;
-      d["period_s"] = r.period_s;
-      d["half_separation_m"] = r.half_separation_m;
-      d["wire_length_m"] = r.wire_length_m;
-      d["mass_kg"] = r.mass_kg;
-      d["printed_kgm2"] = r.printed_kgm2;
-      d["computed_kgm2"] = c.computed_kgm2;
-      d["relative_diff"] = c.relative_diff;
-      d["min_kgm2"] = c.min_kgm2;
-      d["max_kgm2"] = c.max_kgm2;
-      d["consistent"] = c.consistent;
-      d["period_for_printed_s"] = c.period_for_printed_s;
-      d["cg_offset_for_printed_m"] = c.cg_offset_for_printed_m;
+      using namespace pybind11::literals;  // "key"_a = value
+      const py::dict d("axis"_a = r.axis, "period_s"_a = r.period_s, "half_separation_m"_a = r.half_separation_m,
+                       "wire_length_m"_a = r.wire_length_m, "mass_kg"_a = r.mass_kg,
+                       "printed_kgm2"_a = r.printed_kgm2, "computed_kgm2"_a = c.computed_kgm2,
+                       "relative_diff"_a = c.relative_diff, "min_kgm2"_a = c.min_kgm2, "max_kgm2"_a = c.max_kgm2,
+                       "consistent"_a = c.consistent, "period_for_printed_s"_a = c.period_for_printed_s,
+                       "cg_offset_for_printed_m"_a = c.cg_offset_for_printed_m);
       rows.append(d);
     }
     return rows;
