@@ -162,7 +162,7 @@ QssProfile qss_speed_profile(const std::vector<double>& ds_m, const std::vector<
   for (std::size_t i = 0; i < n; ++i) {
     const double k = std::abs(curvature_1pm[i]);
     v[i] = std::min(v_top, k > 0.0 ? std::sqrt(limits.mu * limits.gravity_mps2 / k) : kInf);
-    require(std::isfinite(v[i]), "nothing bounds the speed of a closed lap with a straight: give a drag or a no-load speed");
+    require(!limits.closed || std::isfinite(v[i]), "nothing bounds the speed of a closed lap with a straight: give a drag or a no-load speed");
   }
   if (!limits.closed) {
     v[0] = std::min(v[0], limits.start_speed_mps);
