@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
+#include <mutex>
 #include <limits>
 #include <numbers>
 #include <memory>
@@ -156,14 +158,19 @@ std::optional<SingleTrackParams> limit_lap_vehicle(const P& plant) {
   else return std::nullopt;
 }
 
-// The limit lap's time of the plant's vehicle on the track; NaN where the plant has none or it
-// cannot be computed (said on stderr with progress on).
-template <class P>
-double plant_limit_lap_s(const ClosedLoopConfig& config, const P& plant, const Track& track) {
-  const std::optional<SingleTrackParams> vehicle = limit_lap_vehicle(plant);
-  if (!vehicle) return std::numeric_limits<double>::quiet_NaN();
+// The limit lap's time of a vehicle on the track; NaN where it cannot be computed (said on
+// stderr with progress on). Computed once per track, direction and vehicle in a process (a test
+// suite runs many loops).
+double vehicle_limit_lap_s(const ClosedLoopConfig& config, const SingleTrackParams& vehicle, const Track& track) {
+  static std::mutex mutex;
+  static std::map<std::string, LimitLap> cache;
+  const std::string key =
+      track.name() + (track.direction() == Direction::kClockwise ? " cw\n" : " ccw\n") + to_yaml(vehicle);
   try {
-    const LimitLap lap = limit_lap(track, *vehicle);
+    std::unique_lock lock(mutex);
+    auto it = cache.find(key);
+    if (it == cache.end()) it = cache.emplace(key, limit_lap(track, vehicle)).first;
+    const LimitLap& lap = it->second;
     if (config.progress)
       std::fprintf(stderr, "limit lap of the plant's vehicle: %.2f s (mean %.2f m/s, max %.2f m/s; docs/LIMIT_LAP.md)\n",
                    lap.lap_time_s, lap.mean_speed_mps, lap.max_speed_mps);
@@ -172,6 +179,13 @@ double plant_limit_lap_s(const ClosedLoopConfig& config, const P& plant, const T
     if (config.progress) std::fprintf(stderr, "no limit lap: %s\n", e.what());
     return std::numeric_limits<double>::quiet_NaN();
   }
+}
+
+// The same for the plant's vehicle (limit_lap_vehicle); NaN where the plant has none.
+template <class P>
+double plant_limit_lap_s(const ClosedLoopConfig& config, const P& plant, const Track& track) {
+  const std::optional<SingleTrackParams> vehicle = limit_lap_vehicle(plant);
+  return vehicle ? vehicle_limit_lap_s(config, *vehicle, track) : std::numeric_limits<double>::quiet_NaN();
 }
 
 std::string format_times(const std::vector<double>& times) {

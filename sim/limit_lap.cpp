@@ -17,6 +17,9 @@ void validate(const LimitLapOptions& o) {
     throw Error("limit_lap: safety_margin_m must be finite and >= 0");
   if (!(std::isfinite(o.station_spacing_m) && o.station_spacing_m > 0.0))
     throw Error("limit_lap: station_spacing_m must be finite and > 0");
+  if (o.length_weights_1pm2.empty()) throw Error("limit_lap: length_weights_1pm2 is empty");
+  for (double w : o.length_weights_1pm2)
+    if (!(std::isfinite(w) && w >= 0.0)) throw Error("limit_lap: length_weights_1pm2 must be finite and >= 0");
 }
 
 }  // namespace
@@ -57,7 +60,14 @@ LimitLap limit_lap(const Track& track, const SingleTrackParams& vehicle, const L
   line.margin_m = options.car_half_width_m + options.safety_margin_m;
   line.station_spacing_m = options.station_spacing_m;
   line.max_iterations = options.max_iterations;
-  return lap_on_line(racing_line(track, line).line, limits);
+  LimitLap best;
+  for (double weight : options.length_weights_1pm2) {
+    line.length_weight_1pm2 = weight;
+    LimitLap lap = lap_on_line(racing_line(track, line).line, limits);
+    lap.length_weight_1pm2 = weight;
+    if (best.s_m.empty() || lap.lap_time_s < best.lap_time_s) best = std::move(lap);
+  }
+  return best;
 }
 
 LimitLap centreline_lap(const Track& track, const SingleTrackParams& vehicle, const LimitLapOptions& options) {

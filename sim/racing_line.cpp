@@ -85,29 +85,83 @@ Eigen::VectorXd box_qp(const SparseMatrix& H, const Eigen::VectorXd& f, const Ei
   return x.cwiseMax(lo).cwiseMin(hi);  // feasible even if the active set did not settle
 }
 
-// Offsets n minimising sum_i |p_{i-1} - 2 p_i + p_{i+1}|^2 with p_i = c_i + n_i N_i.
+// Signed Menger curvature at b of the path a -> b -> c (the circle through the three points).
+double menger_curvature(Vec2 a, Vec2 b, Vec2 c) {
+  const double den = distance(a, b) * distance(b, c) * distance(a, c);
+  return den > 0.0 ? 2.0 * cross(b - a, c - b) / den : 0.0;
+}
+
+// Offsets n minimising sum_i kappa_i^2 + w sum_i |p_{i+1} - p_i|^2 / h^2, kappa_i the Menger
+// curvature at p_i = c_i + n_i N_i, h the stations' spacing: the line's curvature traded for its
+// length (w = length_weight; the second sum is least, for a given number of stations, on the
+// shortest line). Gauss-Newton with Levenberg-Marquardt damping from x0: each step minimises
+// |r + J dn|^2 + mu |dn|^2 within the bounds (r the residuals kappa_i and sqrt(w) (p_{i+1} - p_i) / h,
+// J = dr / dn: the curvature rows by central differences), and is taken if it lowers the sum.
 Eigen::VectorXd min_curvature_offsets(const Polyline& c, const Polyline& normal, const Eigen::VectorXd& lo,
-                                      const Eigen::VectorXd& hi, int max_iterations) {
+                                      const Eigen::VectorXd& hi, double length_weight, const Eigen::VectorXd& x0,
+                                      int max_iterations) {
   const auto n = static_cast<Eigen::Index>(c.size());
-  std::vector<Triplet> a;
-  Eigen::VectorXd b(2 * n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const Eigen::Index j[3] = {(i + n - 1) % n, i, (i + 1) % n};
-    const double w[3] = {1.0, -2.0, 1.0};
-    b[i] = b[n + i] = 0.0;
-    for (int k = 0; k < 3; ++k) {
-      a.emplace_back(i, j[k], w[k] * normal[j[k]].x);
-      a.emplace_back(n + i, j[k], w[k] * normal[j[k]].y);
-      b[i] += w[k] * c[j[k]].x;
-      b[n + i] += w[k] * c[j[k]].y;
+  const double h = polyline_length(c, true) / static_cast<double>(n);
+  const double scale = std::sqrt(length_weight) / h;
+  auto point = [&](const Eigen::VectorXd& x, Eigen::Index j, Eigen::Index moved, double dn) {
+    j = (j + n) % n;
+    return c[j] + (x[j] + (j == moved ? dn : 0.0)) * normal[j];
+  };
+  auto kappa = [&](const Eigen::VectorXd& x, Eigen::Index i, Eigen::Index moved, double dn) {
+    return menger_curvature(point(x, i - 1, moved, dn), point(x, i, moved, dn), point(x, i + 1, moved, dn));
+  };
+  auto residuals = [&](const Eigen::VectorXd& x) {
+    Eigen::VectorXd r(3 * n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      r[i] = kappa(x, i, -1, 0.0);
+      const Vec2 d = point(x, i + 1, -1, 0.0) - point(x, i, -1, 0.0);
+      r[n + i] = scale * d.x;
+      r[2 * n + i] = scale * d.y;
     }
+    return r;
+  };
+  Eigen::VectorXd x = x0.cwiseMax(lo).cwiseMin(hi);
+  Eigen::VectorXd r = residuals(x);
+  double damping = -1.0;
+  constexpr double kStep = 1e-6;
+  for (int it = 0; it < 200; ++it) {
+    std::vector<Triplet> jt;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      for (Eigen::Index d = -1; d <= 1; ++d) {
+        const Eigen::Index j = (i + d + n) % n;
+        jt.emplace_back(i, j, (kappa(x, i, j, kStep) - kappa(x, i, j, -kStep)) / (2 * kStep));
+      }
+      const Eigen::Index next = (i + 1) % n;
+      jt.emplace_back(n + i, next, scale * normal[next].x);
+      jt.emplace_back(n + i, i, -scale * normal[i].x);
+      jt.emplace_back(2 * n + i, next, scale * normal[next].y);
+      jt.emplace_back(2 * n + i, i, -scale * normal[i].y);
+    }
+    SparseMatrix J(3 * n, n);
+    J.setFromTriplets(jt.begin(), jt.end());
+    const SparseMatrix H = (J.transpose() * J).pruned();
+    if (damping < 0.0) damping = 1e-3 * H.diagonal().mean();
+    const Eigen::VectorXd f = J.transpose() * r;
+    bool taken = false;
+    while (!taken && damping < 1e12) {
+      SparseMatrix Hd = H;
+      for (Eigen::Index i = 0; i < n; ++i) Hd.coeffRef(i, i) += damping;
+      const Eigen::VectorXd x_new = (x + box_qp(Hd, f, lo - x, hi - x, max_iterations)).cwiseMax(lo).cwiseMin(hi);
+      const Eigen::VectorXd r_new = residuals(x_new);
+      if (r_new.squaredNorm() < r.squaredNorm()) {
+        taken = true;
+        damping = std::max(damping / 3.0, 1e-12);
+        const double moved = (x_new - x).cwiseAbs().maxCoeff();
+        x = x_new;
+        r = r_new;
+        if (moved < 1e-6) return x;
+      } else {
+        damping *= 10.0;
+      }
+    }
+    if (!taken) break;  // no step lowers the sum: a minimum
   }
-  SparseMatrix A(2 * n, n);
-  A.setFromTriplets(a.begin(), a.end());
-  SparseMatrix H = (A.transpose() * A).pruned();
-  for (Eigen::Index i = 0; i < n; ++i) H.coeffRef(i, i) += 1e-9;  // strictly convex
-  const Eigen::VectorXd f = A.transpose() * b;
-  return box_qp(H, f, lo, hi, max_iterations);
+  return x;
 }
 
 // Distance from p to the nearer boundary and the side (+1 along N, -1 against) it lies on.
@@ -154,6 +208,8 @@ RacingLine racing_line(const Track& track, const RacingLineOptions& options) {
   if (!(std::isfinite(options.station_spacing_m) && options.station_spacing_m > 0.0))
     throw Error("racing_line: station_spacing_m must be finite and > 0");
   if (options.max_iterations < 1) throw Error("racing_line: max_iterations must be >= 1");
+  if (!(std::isfinite(options.length_weight_1pm2) && options.length_weight_1pm2 >= 0.0))
+    throw Error("racing_line: length_weight_1pm2 must be finite and >= 0");
   RacingLine r;
   r.centre = resample(track.centreline(), true, options.station_spacing_m);
   if (r.centre.size() < 8) throw Error("racing_line: station_spacing_m leaves fewer than 8 stations");
@@ -171,9 +227,9 @@ RacingLine racing_line(const Track& track, const RacingLineOptions& options) {
                   std::to_string(options.margin_m) + " m");
   }
   // Solve; where an oblique boundary comes closer than the margin, tighten that side and again.
-  Eigen::VectorXd x;
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
   for (int round = 0; round < 20; ++round) {
-    x = min_curvature_offsets(r.centre, r.normal, lo, hi, options.max_iterations);
+    x = min_curvature_offsets(r.centre, r.normal, lo, hi, options.length_weight_1pm2, x, options.max_iterations);
     bool tightened = false;
     for (Eigen::Index i = 0; i < n; ++i) {
       int side = 0;
@@ -199,9 +255,9 @@ void closed_line_curvature(const Polyline& line, std::vector<double>* curvature_
   ds_m->resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const Vec2 a = line[(i + n - 1) % n], b = line[i], c = line[(i + 1) % n];
-    const double den = distance(a, b) * distance(b, c) * distance(a, c);
-    if (!(den > 0.0)) throw Error("closed_line_curvature: vertex " + std::to_string(i) + " repeats a neighbour");
-    (*curvature_1pm)[i] = 2.0 * cross(b - a, c - b) / den;
+    if (!(distance(a, b) > 0.0 && distance(b, c) > 0.0 && distance(a, c) > 0.0))
+      throw Error("closed_line_curvature: vertex " + std::to_string(i) + " repeats a neighbour");
+    (*curvature_1pm)[i] = menger_curvature(a, b, c);
     (*ds_m)[i] = distance(b, c);
   }
 }

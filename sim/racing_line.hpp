@@ -1,9 +1,11 @@
 #pragma once
 // A minimum-curvature racing line on a track: lateral offsets n_i along the normals of the
 // centreline (resampled to uniform stations), bounded by the local half-widths less a margin,
-// that minimise the sum of the line's squared second differences |p_{i-1} - 2 p_i + p_{i+1}|^2,
-// p_i = c_i + n_i N_i (a quadratic programme with box constraints, solved by a primal-dual
-// active-set method with Eigen's sparse LDL^T). Stations where the line comes closer than the margin to a boundary (the normal
+// that minimise the sum of the squared curvatures kappa_i^2 of the line p_i = c_i + n_i N_i
+// (kappa_i: the circle through p_{i-1}, p_i, p_{i+1}), optionally plus a weighted length term.
+// Gauss-Newton with Levenberg-Marquardt
+// damping from the centreline; each step a quadratic programme with box constraints, solved by
+// a primal-dual active-set method with Eigen's sparse LDL^T. Stations where the line comes closer than the margin to a boundary (the normal
 // meets it obliquely) get a tighter bound and the programme is solved again.
 #include <vector>
 
@@ -15,7 +17,11 @@ namespace mppi::sim {
 struct RacingLineOptions {
   double margin_m = 0.5;            // least distance from the line to either boundary [m]
   double station_spacing_m = 0.5;   // centreline stations, about this far apart [m]
-  int max_iterations = 200;         // active-set iterations per solve
+  int max_iterations = 200;         // active-set iterations per quadratic programme
+  // Trades curvature for length: adds w sum |p_{i+1} - p_i|^2 / h^2 (h the spacing; the sum is
+  // least on the shortest line) to the sum of squared curvatures [1/m^2]; 0 = the minimum-curvature
+  // line, large = towards the shortest line. Both sums grow alike with the number of stations.
+  double length_weight_1pm2 = 0.0;
 };
 
 struct RacingLine {

@@ -219,26 +219,31 @@ TEST_CASE("limit lap: the racing line stays on the track and beats the centrelin
   for (const std::string name : {"gazebo", "marietta", "ccrf"}) {
     CAPTURE(name);
     const Track& track = track_named(name);
-    RacingLineOptions line_options;
-    line_options.margin_m = margin;
-    const RacingLine line = racing_line(track, line_options);
-    for (std::size_t i = 0; i < line.line.size(); ++i) {
-      const Vec2 p = line.line[i];
-      CAPTURE(i, p.x, p.y);
-      REQUIRE(inside(track.outer(), p));
-      REQUIRE(!inside(track.inner(), p));
-      REQUIRE(distance_to_polygon(track.outer(), p) >= margin - 1e-9);
-      REQUIRE(distance_to_polygon(track.inner(), p) >= margin - 1e-9);
-    }
     const LimitLap lap = limit_lap(track, plant, options);
     const LimitLap centre = centreline_lap(track, plant, options);
-    std::printf("limit lap %-8s %6.2f s, mean %5.2f m/s, max %5.2f, min %5.2f, line %6.1f m | centreline %6.2f s\n",
+    std::printf("limit lap %-8s %6.2f s, mean %5.2f m/s, max %5.2f, min %5.2f, line %6.1f m (length weight %.2f) | "
+                "centreline %6.2f s\n",
                 name.c_str(), lap.lap_time_s, lap.mean_speed_mps, lap.max_speed_mps, lap.min_speed_mps, lap.length_m,
-                centre.lap_time_s);
+                lap.length_weight_1pm2, centre.lap_time_s);
     CHECK(lap.lap_time_s < centre.lap_time_s);
-    CHECK(lap.x_m.front() == line.line.front().x);  // the lap is on that line
+    // The limit lap's line and the minimum-curvature line keep the margin from both boundaries.
+    for (double weight : {lap.length_weight_1pm2, 0.0}) {
+      RacingLineOptions line_options;
+      line_options.margin_m = margin;
+      line_options.length_weight_1pm2 = weight;
+      const RacingLine line = racing_line(track, line_options);
+      for (std::size_t i = 0; i < line.line.size(); ++i) {
+        const Vec2 p = line.line[i];
+        CAPTURE(weight, i, p.x, p.y);
+        REQUIRE(inside(track.outer(), p));
+        REQUIRE(!inside(track.inner(), p));
+        REQUIRE(distance_to_polygon(track.outer(), p) >= margin - 1e-9);
+        REQUIRE(distance_to_polygon(track.inner(), p) >= margin - 1e-9);
+      }
+      if (weight == lap.length_weight_1pm2) CHECK(lap.x_m.front() == line.line.front().x);  // the lap's line
+    }
     if (name == "gazebo") {
-      // Corners of ~8 m radius at mu ~ 0.77: ~8 m/s; the network at 6 m/s laps in ~10.3 s.
+      // Turns of 5-6 m radius at mu 0.77: 6-7 m/s; the network at 6 m/s laps in 10.3-10.5 s.
       CHECK(lap.lap_time_s > 4.0);
       CHECK(lap.lap_time_s < 10.3);
       CHECK(lap.mean_speed_mps > 6.0);
@@ -273,6 +278,9 @@ TEST_CASE("limit lap: bad input is refused with the reason", "[limit_lap]") {
   options = {};
   options.safety_margin_m = 5.0;
   CHECK_THAT(error_of([&] { limit_lap(gazebo, plant, options); }), Contains("less than twice the margin"));
+  options = {};
+  options.length_weights_1pm2 = {};
+  CHECK_THAT(error_of([&] { limit_lap(gazebo, plant, options); }), Contains("length_weights_1pm2"));
   options = {};
   plant.mass_kg = -1.0;
   CHECK_THAT(error_of([&] { limit_lap(gazebo, plant, options); }), Contains("mass_kg"));
