@@ -181,7 +181,7 @@ Polyline left_normals(const Polyline& line) {
   for (std::size_t i = 0; i < n; ++i) {
     const Vec2 t = line[(i + 1) % n] - line[(i + n - 1) % n];
     const double len = norm(t);
-    if (!(len > 0.0)) throw Error("left_normals: vertices " + std::to_string(i) + "'s neighbours coincide");
+    if (!(len > 0.0)) throw Error("left_normals: the neighbours of vertex " + std::to_string(i) + " coincide");
     normal[i] = {-t.y / len, t.x / len};
   }
   return normal;
