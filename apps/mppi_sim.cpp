@@ -9,6 +9,7 @@
 #include "cli/sim_command_line.hpp"
 #include "dynamics/model_registry.hpp"
 #include "sim/closed_loop.hpp"
+#include "sim/limit_lap_report.hpp"
 #include "sim/summary.hpp"
 #ifdef MPPI_HAVE_OCS
 #include "ocs/serve.hpp"
@@ -39,6 +40,14 @@ int main(int argc, char** argv) {
   }
   const mppi::sim::ClosedLoopConfig& config = cl.config;
   try {
+    if (cl.limit_lap) {
+      const mppi::sim::LimitLap lap = mppi::sim::report_limit_lap(config);
+      std::printf("limit lap of the %s plant on %s%s:\n%s", config.plant.c_str(), config.track.c_str(),
+                  config.clockwise ? " (clockwise)" : "", mppi::sim::describe_limit_lap(lap).c_str());
+      if (!config.out_dir.empty())
+        std::printf("-> %s/limit_lap.csv, %s/limit_lap.png\n", config.out_dir.c_str(), config.out_dir.c_str());
+      return 0;
+    }
 #ifdef MPPI_HAVE_OCS
     mppi::ocs::ServeOptions serve;
     serve.port = serve_port;

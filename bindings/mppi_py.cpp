@@ -389,6 +389,8 @@ PYBIND11_MODULE(mppi, m) {
       .def_readonly("finished", &Sum::finished)
       .def_readonly("laps_completed", &Sum::laps_completed)
       .def_readonly("lap_times_s", &Sum::lap_times_s)
+      .def_readonly("limit_lap_s", &Sum::limit_lap_s)
+      .def_readonly("lap_time_ratio", &Sum::lap_time_ratio)
       .def_readonly("crashes", &Sum::crashes)
       .def_readonly("crash_reasons", &Sum::crash_reasons)
       .def_readonly("stalls", &Sum::stalls)

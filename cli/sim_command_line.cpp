@@ -42,6 +42,9 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
   add_model_option(app, "--plant", c.plant, "simulated car: a registered model, or corrected", {}, {"corrected"});
   app.add_flag("--list-models", cl.list_models, "every model with its data file, states and parameters, and exit")
       ->configurable(false);
+  app.add_flag("--limit-lap", cl.limit_lap,
+               "print the plant's limit lap on the track (minimum-time lap on a racing line, docs/LIMIT_LAP.md), "
+               "write DIR/limit_lap.csv and DIR/limit_lap.png (--out), and exit");
   app.add_option("--speed", c.target_speed_mps, "target speed [m/s]")->type_name("MPS");
   app.add_option("--laps", c.laps, "laps to drive")->type_name("N");
   app.add_option("--max-time", c.max_time_s, "stop after S simulated seconds (0: from the laps)")->type_name("S");

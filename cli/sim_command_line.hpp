@@ -17,6 +17,7 @@ struct SimCommandLine {
   bool print_json = false;   // --json: summary.json to stdout
   bool quiet = false;        // --quiet: config.progress = false
   bool list_models = false;  // --list-models: print the models and exit
+  bool limit_lap = false;    // --limit-lap: print the plant's limit lap on the track, write it, and exit
   std::string data_dir;      // --data-dir
   RunFile run_file;          // --config, --dump-config
 

@@ -51,6 +51,12 @@ sim gazebo_double_track_6mps_3laps --model double-track --plant double-track --l
 sim gazebo_full_vehicle_6mps_3laps --model full-vehicle --plant full-vehicle --laps 3 --backend cpu
 sim gazebo_single_track_on_full_vehicle_6mps_3laps --model single-track --plant full-vehicle --laps 3 --backend cpu
 sim ccrf_nn_6mps --track ccrf --laps 1 --backend cpu
+# The limit lap of the default plant (docs/LIMIT_LAP.md).
+for track in gazebo ccrf; do
+  echo "[docs_figures] mppi-sim --limit-lap --track $track -> docs/results/limit_lap_$track.png"
+  "$bin/mppi-sim" --limit-lap --track "$track" --out "$out/limit_lap_$track" > /dev/null
+  cp "$out/limit_lap_$track/limit_lap.png" "docs/results/limit_lap_$track.png"
+done
 if [ "$vulkan" = 1 ]; then
   sim gazebo_nn_6mps_5laps_vulkan_lavapipe --laps 5 --seed 1 --backend vulkan
 fi

@@ -5,6 +5,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
+#include <mutex>
+#include <limits>
 #include <numbers>
 #include <memory>
 #include <optional>
@@ -25,6 +28,7 @@
 #include "sim/data_dir.hpp"
 #include "sim/geometry.hpp"
 #include "sim/lap_counter.hpp"
+#include "sim/limit_lap.hpp"
 #include "sim/path_predictor.hpp"
 #include "sim/recording.hpp"
 #include "sim/track_plot.hpp"
@@ -146,6 +150,44 @@ ControllerSetup make_controller(const ClosedLoopConfig& config, const AutoRallyC
   }, "controller model");
 }
 
+// The vehicle whose limit lap a plant is measured against (plant_vehicle_params).
+template <class P>
+std::optional<SingleTrackParams> limit_lap_vehicle(const P& plant) {
+  if constexpr (requires { plant.params().rigid_limit(); }) return plant.params().rigid_limit().base;
+  else if constexpr (HasSingleTrackCore<P>) return SingleTrackParams(single_track_core(plant.params()));
+  else return std::nullopt;
+}
+
+// The limit lap's time of a vehicle on the track; NaN where it cannot be computed (said on
+// stderr with progress on). Computed once per track, direction and vehicle in a process (a test
+// suite runs many loops).
+double vehicle_limit_lap_s(const ClosedLoopConfig& config, const SingleTrackParams& vehicle, const Track& track) {
+  static std::mutex mutex;
+  static std::map<std::string, LimitLap> cache;
+  const std::string key =
+      track.name() + (track.direction() == Direction::kClockwise ? " cw\n" : " ccw\n") + to_yaml(vehicle);
+  try {
+    std::unique_lock lock(mutex);
+    auto it = cache.find(key);
+    if (it == cache.end()) it = cache.emplace(key, limit_lap(track, vehicle)).first;
+    const LimitLap& lap = it->second;
+    if (config.progress)
+      std::fprintf(stderr, "limit lap of the plant's vehicle: %.2f s (mean %.2f m/s, max %.2f m/s; docs/LIMIT_LAP.md)\n",
+                   lap.lap_time_s, lap.mean_speed_mps, lap.max_speed_mps);
+    return lap.lap_time_s;
+  } catch (const Error& e) {
+    if (config.progress) std::fprintf(stderr, "no limit lap: %s\n", e.what());
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+// The same for the plant's vehicle (limit_lap_vehicle); NaN where the plant has none.
+template <class P>
+double plant_limit_lap_s(const ClosedLoopConfig& config, const P& plant, const Track& track) {
+  const std::optional<SingleTrackParams> vehicle = limit_lap_vehicle(plant);
+  return vehicle ? vehicle_limit_lap_s(config, *vehicle, track) : std::numeric_limits<double>::quiet_NaN();
+}
+
 std::string format_times(const std::vector<double>& times) {
   std::string s;
   char buf[32];
@@ -161,6 +203,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
                           const AutoRallyCost& cost) {
   ControllerSetup setup = make_controller(config, cost);
   Controller* controller = setup.controller.get();
+  const double limit_lap_s = plant_limit_lap_s(config, plant_model, track);
   Plant<P> plant(std::move(plant_model), config.actuators, static_cast<float>(config.plant_dt_s));
   const Pose2 start = track.start_pose();
   VehicleState s0;
@@ -206,6 +249,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   summary.horizon = config.controller.horizon;
   summary.target_speed_mps = config.target_speed_mps;
   summary.backend = setup.backend;
+  summary.limit_lap_s = limit_lap_s;
   long control_step = 0;
 
   std::vector<float> model_x(static_cast<std::size_t>(setup.model_states));
@@ -351,8 +395,11 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
     if (laps.laps_completed() > reported_laps && config.progress) {
       reported_laps = laps.laps_completed();
       const double lap_time = laps.lap_times_s().back();
-      std::fprintf(stderr, "lap %d/%d: %.2f s (mean %.2f m/s), crashes so far %d, t = %.1f s\n",
-                   reported_laps, config.laps, lap_time, track.length_m() / lap_time,
+      char ratio[80] = "";
+      if (std::isfinite(limit_lap_s))
+        std::snprintf(ratio, sizeof ratio, "%.2f x the limit lap %.2f s; ", lap_time / limit_lap_s, limit_lap_s);
+      std::fprintf(stderr, "lap %d/%d: %.2f s (%smean %.2f m/s), crashes so far %d, t = %.1f s\n",
+                   reported_laps, config.laps, lap_time, ratio, track.length_m() / lap_time,
                    summary.crashes, t);
     }
   }
@@ -360,6 +407,8 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   summary.sim_time_s = t;
   summary.laps_completed = laps.laps_completed();
   summary.lap_times_s = laps.lap_times_s();
+  if (std::isfinite(limit_lap_s))
+    for (double lap_time : summary.lap_times_s) summary.lap_time_ratio.push_back(lap_time / limit_lap_s);
   summary.finished = summary.laps_completed >= config.laps;
   summary.mean_speed_mps = speed_samples ? speed_sum / speed_samples : 0.0;
   summary.optimizer_ms_p50 = percentile(optimizer_ms, 50);
@@ -386,6 +435,18 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
 }
 
 }  // namespace
+
+std::optional<SingleTrackParams> plant_vehicle_params(const ClosedLoopConfig& config) {
+  if (!config.surface_yaml.empty() || config.plant == models::SingleTrackModel::kName)
+    return load_single_track_params(model_file<models::SingleTrackModel>(config.plant_params_yaml, config.network_npz));
+  if (config.plant == kCorrectedModel) return std::nullopt;
+  return with_model(config.plant, [&]<class D>() -> std::optional<SingleTrackParams> {
+    if constexpr (HasSingleTrackCore<typename D::Model>)
+      return limit_lap_vehicle(D::load(model_file<D>(config.plant_params_yaml, config.network_npz)));
+    else
+      return std::nullopt;
+  }, "plant");
+}
 
 RunSummary run_closed_loop(const ClosedLoopConfig& config) {
   TrackOptions track_options;

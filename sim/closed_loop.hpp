@@ -6,12 +6,14 @@
 // car is then put back on the centreline at rest, and the run goes on; so is a car that stalls,
 // making no progress along the track). Seeded, deterministic.
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "dynamics/models/autorally_nn_model.hpp"
 #include "dynamics/models/single_track_model.hpp"
+#include "dynamics/vehicle_params.hpp"
 #include "mppi/backend_choice.hpp"
 #include "mppi/controller_options.hpp"
 #include "sim/plant.hpp"
@@ -66,7 +68,16 @@ struct ClosedLoopConfig {
   StepObserver* observer = nullptr;       // sees every step, brings the operator's requests
 };
 
-// Runs the loop; throws mppi::Error for bad settings or data files.
+// Runs the loop; throws mppi::Error for bad settings or data files. For a plant with
+// single-track parameters (plant_vehicle_params) each lap is also given as a ratio to that
+// vehicle's limit lap on the track (sim/limit_lap.hpp; RunSummary::limit_lap_s, lap_time_ratio).
 RunSummary run_closed_loop(const ClosedLoopConfig& config);
+
+// The single-track parameters of the config's plant, whose limit lap its laps are measured
+// against: the single-track plant's file; the double-track's base; the full vehicle's base with
+// its drag as aero_drag_kgpm (FullVehicleParams::rigid_limit). None for the other plants (the
+// network, the kinematic bicycle, corrected-model files). Throws mppi::Error for an unknown
+// plant or a bad data file.
+std::optional<SingleTrackParams> plant_vehicle_params(const ClosedLoopConfig& config);
 
 }  // namespace mppi::sim

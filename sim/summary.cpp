@@ -31,6 +31,9 @@ std::string to_json(const RunSummary& s) {
   j["laps_completed"] = s.laps_completed;
   j["lap_times_s"] = nlohmann::ordered_json::array();
   for (double t : s.lap_times_s) j["lap_times_s"].push_back(number(t));
+  j["limit_lap_s"] = number(s.limit_lap_s);
+  j["lap_time_ratio"] = nlohmann::ordered_json::array();
+  for (double r : s.lap_time_ratio) j["lap_time_ratio"].push_back(number(r));
   j["crashes"] = s.crashes;
   j["crash_reasons"] = s.crash_reasons;
   j["stalls"] = s.stalls;

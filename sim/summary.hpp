@@ -1,6 +1,7 @@
 #pragma once
 // The summary of one closed-loop run, written as JSON next to the run's recording and plot.
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,10 @@ struct RunSummary {
   bool finished = false;              // reached the requested laps / time without stopping early
   int laps_completed = 0;
   std::vector<double> lap_times_s;
+  // The limit lap of the plant's vehicle file on this track (sim/limit_lap.hpp) and each lap's
+  // time over it; NaN and empty for plants without single-track parameters.
+  double limit_lap_s = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> lap_time_ratio;
   int crashes = 0;
   std::vector<std::string> crash_reasons;
   // Stalls: the car made less than ClosedLoopConfig::stall_progress_m of progress along the track

@@ -290,3 +290,16 @@ TEST_CASE("cli: the shipped example run file is a valid mppi-sim configuration",
   CHECK(cl.config.track == "gazebo");
   CHECK(cl.config.laps == 3);
 }
+
+TEST_CASE("cli: --limit-lap is a flag of the command line, the run file and --help", "[cli][limit_lap]") {
+  CHECK_FALSE(parse_sim({}).limit_lap);
+  CHECK(parse_sim({"--limit-lap"}).limit_lap);
+  const TempFile file("limit-lap: true\ntrack: ccrf\n");
+  const SimCommandLine cl = parse_sim({"--config", file.str()});
+  CHECK(cl.limit_lap);
+  CHECK(cl.config.track == "ccrf");
+  CLI::App app{"", "mppi-sim"};
+  SimCommandLine help;
+  mppi::cli::add_sim_options(app, help);
+  CHECK(app.help().find("--limit-lap") != std::string::npos);
+}

@@ -46,6 +46,8 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.finished = true;
   s.laps_completed = 2;
   s.lap_times_s = {12.5, 11.75};
+  s.limit_lap_s = 6.25;
+  s.lap_time_ratio = {2.0, 1.88};
   s.crashes = 1;
   s.crash_reasons = {"hit the outer barrier at (1.00, 2.00)"};
   s.stalls = 1;
@@ -59,7 +61,7 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.p95_slip_angle_rad = 0.125;
   s.peak_lateral_accel_mps2 = 6.5;
   const auto j = nlohmann::json::parse(to_json(s));
-  CHECK(j.size() == 26);
+  CHECK(j.size() == 28);
   CHECK(j.at("track") == "gazebo");
   CHECK(j.at("model") == "nn_autorally");
   CHECK(j.at("plant") == "single_track");
@@ -71,6 +73,8 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   CHECK(j.at("finished") == true);
   CHECK(j.at("laps_completed") == 2);
   CHECK(j.at("lap_times_s") == nlohmann::json::array({12.5, 11.75}));
+  CHECK(j.at("limit_lap_s") == 6.25);
+  CHECK(j.at("lap_time_ratio") == nlohmann::json::array({2.0, 1.88}));
   CHECK(j.at("crashes") == 1);
   CHECK(j.at("crash_reasons")[0] == "hit the outer barrier at (1.00, 2.00)");
   CHECK(j.at("stalls") == 1);
