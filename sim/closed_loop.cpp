@@ -437,7 +437,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
 }  // namespace
 
 std::optional<SingleTrackParams> plant_vehicle_params(const ClosedLoopConfig& config) {
-  if (!config.surface_yaml.empty() || config.plant == models::SingleTrackModel::kName)
+  if (!config.surface_yaml.empty())  // the single-track plant on a surface map: its own car file
     return load_single_track_params(model_file<models::SingleTrackModel>(config.plant_params_yaml, config.network_npz));
   if (config.plant == kCorrectedModel) return std::nullopt;
   return with_model(config.plant, [&]<class D>() -> std::optional<SingleTrackParams> {
