@@ -137,6 +137,32 @@ PYBIND11_MODULE(mppi, m) {
   py::register_exception<mppi::Error>(m, "Error", PyExc_RuntimeError);
 
   // ---- options and step summary ----
+  py::enum_<mppi::SamplerKind>(m, "SamplerKind", "how the perturbations are drawn along the horizon")
+      .value("GAUSSIAN", mppi::SamplerKind::kGaussian)
+      .value("LOW_PASS", mppi::SamplerKind::kLowPass)
+      .value("SMOOTH", mppi::SamplerKind::kSmooth);
+  py::class_<mppi::SamplerOptions>(m, "SamplerOptions", "the sampler (gaussian, low-pass, derivative-space)")
+      .def(py::init<>())
+      .def_readwrite("kind", &mppi::SamplerOptions::kind)
+      .def_readwrite("cutoff_hz", &mppi::SamplerOptions::cutoff_hz)
+      .def_readwrite("smooth_time_s", &mppi::SamplerOptions::smooth_time_s);
+  py::class_<mppi::TemperatureTarget>(m, "TemperatureTarget",
+                                      "adaptive temperature: lambda held at an effective-sample-size share")
+      .def(py::init<>())
+      .def_readwrite("ess_share", &mppi::TemperatureTarget::ess_share, "target ESS / K; 0 = fixed lambda")
+      .def_readwrite("lambda_min", &mppi::TemperatureTarget::lambda_min)
+      .def_readwrite("lambda_max", &mppi::TemperatureTarget::lambda_max)
+      .def_readwrite("tolerance", &mppi::TemperatureTarget::tolerance);
+  py::class_<mppi::ActuatorChannel>(m, "ActuatorChannel",
+                                    "one channel's actuator: pure delay, rate limit, first-order lag")
+      .def(py::init<>())
+      .def(py::init([](float delay_s, float lag_s, float rate_per_s) {
+             return mppi::ActuatorChannel{delay_s, lag_s, rate_per_s};
+           }),
+           py::arg("delay_s") = 0.f, py::arg("lag_s") = 0.f, py::arg("rate_per_s") = 0.f)
+      .def_readwrite("delay_s", &mppi::ActuatorChannel::delay_s)
+      .def_readwrite("lag_s", &mppi::ActuatorChannel::lag_s)
+      .def_readwrite("rate_per_s", &mppi::ActuatorChannel::rate_per_s, "0 = unlimited");
   py::class_<mppi::ControllerOptions>(m, "ControllerOptions",
                                       "MPPI settings (AutoRally defaults: K = 1920, T = 100, 50 Hz)")
       .def(py::init<>())
@@ -154,6 +180,10 @@ PYBIND11_MODULE(mppi, m) {
       .def_readwrite("smoothing_order", &mppi::ControllerOptions::smoothing_order)
       .def_readwrite("seed", &mppi::ControllerOptions::seed)
       .def_readwrite("num_threads", &mppi::ControllerOptions::num_threads)
+      .def_readwrite("sampler", &mppi::ControllerOptions::sampler)
+      .def_readwrite("temperature", &mppi::ControllerOptions::temperature)
+      .def_readwrite("actuators", &mppi::ControllerOptions::actuators,
+                     "list of ActuatorChannel, one per control channel (empty: none)")
       .def("is_valid", [](const mppi::ControllerOptions& o, int num_controls) {
         std::string why;
         const bool ok = o.is_valid(num_controls, &why);
@@ -174,6 +204,7 @@ PYBIND11_MODULE(mppi, m) {
       .def_readonly("effective_sample_size", &mppi::StepSummary::effective_sample_size)
       .def_readonly("valid_samples", &mppi::StepSummary::valid_samples)
       .def_readonly("iterations", &mppi::StepSummary::iterations)
+      .def_readonly("lambda_", &mppi::StepSummary::lambda, "temperature of the weights")
       .def_readonly("optimizer_ms", &mppi::StepSummary::optimizer_ms);
 
   py::class_<mppi::VehicleState>(m, "VehicleState", "common vehicle state (ISO 8855, SI units)")
@@ -341,6 +372,17 @@ PYBIND11_MODULE(mppi, m) {
         std::copy(n.begin(), n.end(), a.mutable_data());
         return a;
       }, "the plan, T x num_controls")
+      .def_property_readonly("sampled_controls", [](const PyController& c) {
+        const int t = c.controller->options().horizon, k = c.controller->options().num_samples;
+        const auto v = c.controller->sampled_controls();
+        FloatArray a({t, c.nu, k});
+        if (v.empty()) return a;  // nothing sampled yet
+        const auto padded = static_cast<std::size_t>(c.controller->backend().shape().padded_samples);
+        float* out = a.mutable_data();
+        for (std::size_t r = 0; r < static_cast<std::size_t>(t) * c.nu; ++r)
+          std::copy_n(v.begin() + static_cast<std::ptrdiff_t>(r * padded), k, out + r * k);
+        return a;
+      }, "the last iteration's sampled control sequences, T x num_controls x K")
       .def_property_readonly("sampled_costs", [](const PyController& c) { return to_array(c.controller->sampled_costs()); })
       .def_property_readonly("weights", [](const PyController& c) { return to_array(c.controller->weights()); });
 
@@ -372,6 +414,7 @@ PYBIND11_MODULE(mppi, m) {
       .def_readwrite("model_params_yaml", &Cfg::model_params_yaml)
       .def_readwrite("network_npz", &Cfg::network_npz)
       .def_readwrite("actuators", &Cfg::actuators)
+      .def_readwrite("actuator_model", &Cfg::actuator_model, "none | plant | a corrected-model file")
       .def_readwrite("plant_dt_s", &Cfg::plant_dt_s)
       .def_readwrite("out_dir", &Cfg::out_dir)
       .def_readwrite("progress", &Cfg::progress);
@@ -400,6 +443,11 @@ PYBIND11_MODULE(mppi, m) {
       .def_readonly("optimizer_ms_p50", &Sum::optimizer_ms_p50)
       .def_readonly("optimizer_ms_p99", &Sum::optimizer_ms_p99)
       .def_readonly("effective_sample_size_mean", &Sum::effective_sample_size_mean)
+      .def_readonly("sampler", &Sum::sampler)
+      .def_readonly("ess_target_share", &Sum::ess_target_share)
+      .def_readonly("ess_in_band_share", &Sum::ess_in_band_share)
+      .def_readonly("lambda_p50", &Sum::lambda_p50)
+      .def_readonly("actuator_model", &Sum::actuator_model)
       .def("to_json", [](const Sum& s) { return mppi::sim::to_json(s); });
 
   m.def("run_closed_loop", [](const Cfg& config) {

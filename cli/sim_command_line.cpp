@@ -67,6 +67,36 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
   add_float_option(app, "--lambda", mppi.lambda, "MPPI temperature")->type_name("L");
   app.add_option("--smoothing", mppi.smoothing_window, "Savitzky-Golay window over the plan (odd, <= the horizon; upstream AutoRally: 5), 0 = off")
       ->type_name("W");
+  app.add_option_function<std::string>(
+         "--sampler", [&mppi](const std::string& name) { parse_sampler_kind(name, &mppi.sampler.kind); },
+         "how the perturbations are drawn along the horizon: gaussian (white, the paper's) | lowpass (a "
+         "first-order low-pass, --sampler-cutoff) | smooth (drawn on the controls' rate and integrated, as "
+         "SMPPI, --smooth-time)")
+      ->type_name("NAME")
+      ->check(CLI::IsMember({"gaussian", "lowpass", "smooth"}).name("SAMPLER").description(""))
+      ->default_str(sampler_name(mppi.sampler.kind));
+  add_float_option(app, "--sampler-cutoff", mppi.sampler.cutoff_hz, "lowpass sampler: corner frequency [Hz]")
+      ->type_name("HZ")
+      ->check(CLI::PositiveNumber);
+  add_float_option(app, "--smooth-time", mppi.sampler.smooth_time_s,
+                   "smooth sampler: time at which the integrated noise reaches the noise's standard deviation [s]")
+      ->type_name("S")
+      ->check(CLI::PositiveNumber);
+  add_float_option(app, "--ess-target", mppi.temperature.ess_share,
+                   "adaptive temperature: lambda set at every step so that the effective sample size is this "
+                   "share of the samples (0 = fixed --lambda)")
+      ->type_name("SHARE")
+      ->check(CLI::Range(0.0, 1.0));
+  add_float_option(app, "--lambda-min", mppi.temperature.lambda_min, "adaptive temperature: lowest lambda")
+      ->type_name("L")
+      ->check(CLI::PositiveNumber);
+  add_float_option(app, "--lambda-max", mppi.temperature.lambda_max, "adaptive temperature: highest lambda")
+      ->type_name("L")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--actuator-model", c.actuator_model,
+                 "the actuators the controller plans through (delay, rate limit, lag per channel): none | plant "
+                 "(the simulated car's own) | a corrected-model FILE (mppi-fit diagnose)")
+      ->type_name("SOURCE");
   add_seed_option(app, mppi.seed);
   add_threads_option(app, mppi.num_threads);
   add_backend_option(app, c.backend);

@@ -9,7 +9,9 @@
 #include <string>
 #include <string_view>
 
+#include "mppi/actuator_chain.hpp"
 #include "mppi/cost_map.hpp"
+#include "mppi/sampler.hpp"
 
 namespace mppi {
 
@@ -34,6 +36,8 @@ struct IterationInput {
   float lambda = 1.f;                  // temperature
   std::uint64_t seed = 0;              // Philox key (the same numbers as the CPU path)
   std::uint32_t iteration = 0;         // Philox counter word 2
+  NoiseFilter noise_filter;            // the sampler's recursion over the normals (white: none)
+  ActuatorPlan actuators;              // the actuators between command and model (none: off)
 };
 struct IterationOutput {
   std::span<float> next;     // T x nu: sum_k w_k V_k (before smoothing)
@@ -70,6 +74,8 @@ class Backend {
                        std::span<float> costs) = 0;
   // True if iterate() works: then Controller hands each iteration over whole.
   virtual bool has_iterate() const { return false; }
+  // True if iterate() rolls out through IterationInput::actuators.
+  virtual bool supports_actuators() const { return false; }
   // Samples V_k = clamp(U + eps_k) with the Philox numbers of mppi/noise.hpp, rolls out, and
   // forms the weights and the weighted sum, as Controller does on the CPU.
   virtual void iterate(const IterationInput& /*in*/, IterationOutput& /*out*/) {}

@@ -23,6 +23,8 @@
 
 #include "base/error.hpp"
 #include "base/multiversion.hpp"
+#include "mppi/actuator_chain.hpp"
+#include "mppi/adaptive_temperature.hpp"
 #include "mppi/backend.hpp"
 #include "mppi/controller_options.hpp"
 #include "mppi/cpu_backend.hpp"
@@ -50,24 +52,29 @@ struct StepSummary {
   float effective_sample_size = 0.f; // 1 / sum w^2 (last iteration), in [1, K]
   int valid_samples = 0;             // samples with a finite cost (last iteration)
   int iterations = 0;                // iterations run
+  float lambda = 0.f;                // temperature of the weights (last iteration)
   double optimizer_ms = 0.0;         // wall time of step()
 };
 
 namespace detail {
-// Draws V = clamp(U + std * n) for samples [k0, k0 + kChunk) and every t; control cost per lane.
+// Draws V = clamp(U + std * eps) for samples [k0, k0 + kChunk) and every t (eps: the sampler's
+// filtered normals, mppi/sampler.hpp); control cost per lane.
 MPPI_MULTIVERSION inline void sample_chunk(const NoiseKey& key, std::uint32_t iteration, int k0,
                                            int num_samples, int padded, int horizon, int nu,
                                            const float* nominal, const float* noise_std,
                                            const float* lo, const float* hi, float gamma,
-                                           float* controls, float* control_cost) noexcept {
+                                           float* controls, float* control_cost,
+                                           const NoiseFilter& filter = {}) noexcept {
   constexpr int W = kChunk;
   alignas(64) float acc[W] = {};
+  alignas(64) float eps_state[kMaxNoiseChannels * W];
   const float valid_lanes = static_cast<float>(num_samples - k0);  // lanes j >= this get no noise
   const auto stride = static_cast<std::size_t>(padded);
   for (int t = 0; t < horizon; t += 2)
     sample_step_pair<W>(key, iteration, k0, valid_lanes, t, std::min(2, horizon - t), nu, nominal + t * nu,
-                        noise_std, lo, hi, gamma, controls + static_cast<std::size_t>(t) * nu * stride + k0,
-                        stride, static_cast<std::size_t>(nu) * stride, acc);
+                        noise_std, lo, hi, gamma, filter, eps_state,
+                        controls + static_cast<std::size_t>(t) * nu * stride + k0, stride,
+                        static_cast<std::size_t>(nu) * stride, acc);
   std::copy_n(acc, W, control_cost + k0);
 }
 }  // namespace detail
@@ -117,6 +124,15 @@ class Controller {
     x0_.assign(nx_, 0.f);
     if (options_.smoothing_window > 0)
       smoother_ = SavitzkyGolay(options_.horizon, options_.smoothing_window, options_.smoothing_order);
+    noise_filter_ = make_noise_filter(options_.sampler, options_.dt_s);
+    lambda_ = options_.lambda;
+    if (!options_.actuators.empty()) {
+      if (!backend_->supports_actuators())
+        throw Error(std::string("ControllerOptions: actuator-aware planning needs a backend that rolls out "
+                                "through the actuators (the CPU backend); the ") +
+                    backend_->name() + " backend does not");
+      for (const ActuatorChannel& c : options_.actuators) actuator_steps_.push_back(actuator_step(c, options_.dt_s));
+    }
     reset();
   }
 
@@ -165,6 +181,7 @@ class Controller {
         return safe_output(sum, start);
       }
     }
+    sent(output_);
     shift_nominal();
     ++step_index_;
     sum.optimizer_ms = elapsed_ms(start);
@@ -208,11 +225,21 @@ class Controller {
         std::move(backend_), healthy_steps * static_cast<std::uint64_t>(options_.iterations));
   }
 
-  // Forget the plan: nominal = zero controls clamped to the limits.
+  // Forget the plan (nominal = zero controls clamped to the limits) and the actuators' state
+  // (at rest: every input 0, nothing pending).
   void reset() {
     reset_plan();
     step_index_ = 0;
+    actuator_state_ = ActuatorState{};
   }
+
+  // The actuator chain's state (options().actuators): the commands sent but not yet acting and
+  // the rate limiter's and the lag's outputs. step() advances it with every command it returns;
+  // set it where the real actuators are measured (a servo's position) or were reset.
+  const ActuatorState& actuator_state() const { return actuator_state_; }
+  void set_actuator_state(const ActuatorState& s) { actuator_state_ = s; }
+  // The temperature the next iteration starts from (options().lambda unless adaptive).
+  float temperature() const { return lambda_; }
 
   std::span<const float> nominal() const { return nominal_; }  // T x nu, row-major
   // The sampled sequences and costs of the last iteration (T x nu x padded; padded).
@@ -243,7 +270,7 @@ class Controller {
       detail::sample_chunk(key, iteration, chunk * kChunk, options_.num_samples, padded_,
                            options_.horizon, nu_, nominal_.data(), options_.noise_std.data(),
                            options_.control_min.data(), options_.control_max.data(), gamma,
-                           controls_.data(), control_costs_.data());
+                           controls_.data(), control_costs_.data(), noise_filter_);
     });
   }
 
@@ -268,7 +295,23 @@ class Controller {
       sum.reason = "every sampled rollout cost was NaN or infinite";
       return false;
     }
-    const float inv_lambda = 1.f / options_.lambda;
+    if (adaptive()) lambda_ = solve_temperature(std::span<const float>(costs_).first(k_count), options_.temperature, lambda_);
+    sum.lambda = lambda_;
+    sum.min_cost = min_cost;
+    sum.mean_cost = static_cast<float>(cost_sum / valid);
+    sum.effective_sample_size = exponential_weights(min_cost, lambda_);
+    weighted_sum(controls_.data());
+    commit_next();
+    return true;
+  }
+
+  bool adaptive() const { return options_.temperature.ess_share > 0.f; }
+
+  // weights_ <- exp(-(S_k - min_cost) / lambda) / eta over costs_ (0 where not finite);
+  // returns the effective sample size 1 / sum w^2.
+  float exponential_weights(float min_cost, float lambda) {
+    const int k_count = options_.num_samples;
+    const float inv_lambda = 1.f / lambda;
     double eta = 0.0;
     for (int k = 0; k < k_count; ++k) {
       const float s = costs_[k];
@@ -282,23 +325,17 @@ class Controller {
       weights_[k] *= inv_eta;
       sum_sq += static_cast<double>(weights_[k]) * weights_[k];
     }
-    sum.min_cost = min_cost;
-    sum.mean_cost = static_cast<float>(cost_sum / valid);
-    sum.effective_sample_size = static_cast<float>(1.0 / sum_sq);
-    weighted_sum();
-    commit_next();
-    return true;
+    return static_cast<float>(1.0 / sum_sq);
   }
 
-  // U <- sum_k w_k V_k into next_.
-  void weighted_sum() {
+  // U <- sum_k w_k V_k into next_ (v: T x nu x padded).
+  void weighted_sum(const float* v) {
     const int k_count = options_.num_samples;
 
     // U <- sum_k w_k V_k: one row (t, c) per task, summed over k in a fixed order, so the
     // result does not depend on the thread count.
     const int rows = options_.horizon * nu_;
     float* next = next_.data();
-    const float* v = controls_.data();
     const float* w = weights_.data();
     const int padded = padded_;
     runner_->run(rows, 8, [&](int row, int) {
@@ -319,6 +356,9 @@ class Controller {
     in.lambda = options_.lambda;
     in.seed = options_.seed;
     in.iteration = iteration;
+    in.lambda = lambda_;
+    in.noise_filter = noise_filter_;
+    if (!actuator_steps_.empty()) in.actuators = {actuator_steps_.data(), &actuator_state_};
     IterationOutput out;
     out.next = next_;
     out.costs = costs_;
@@ -335,8 +375,27 @@ class Controller {
     sum.min_cost = out.min_cost;
     sum.mean_cost = out.mean_cost;
     sum.effective_sample_size = 1.f / out.sum_sq_weights;
+    sum.lambda = lambda_;
+    if (adaptive()) retemper(out.min_cost, sum);
     commit_next();
     return true;
+  }
+
+  // Adaptive temperature after a backend's iteration, which weighted with lambda_: the
+  // temperature that meets the target on this iteration's costs becomes lambda_; if the
+  // weights used missed the target by more than the tolerance, they and next_ are formed again
+  // at it from the sampled controls (drawn again by the CPU backend).
+  void retemper(float min_cost, StepSummary& sum) {
+    const auto costs = std::span<const float>(costs_).first(options_.num_samples);
+    const float want = options_.temperature.ess_share * static_cast<float>(options_.num_samples);
+    const bool missed = std::abs(sum.effective_sample_size - want) > options_.temperature.tolerance * want;
+    lambda_ = solve_temperature(costs, options_.temperature, lambda_);
+    if (!missed) return;
+    const std::span<const float> v = backend_->sampled_controls();
+    if (v.size() < next_.size() * static_cast<std::size_t>(padded_)) return;  // keeps none: weights stand
+    sum.effective_sample_size = exponential_weights(min_cost, lambda_);
+    sum.lambda = lambda_;
+    weighted_sum(v.data());
   }
 
   // nominal <- next_ (smoothed and clamped if smoothing is on).
@@ -350,6 +409,11 @@ class Controller {
     } else {
       std::copy(next_.begin(), next_.end(), nominal_.begin());
     }
+  }
+
+  // The command goes out: the actuator chain moves on by one step.
+  void sent(std::span<const float> command) {
+    if (!actuator_steps_.empty()) advance_actuators(actuator_steps_.data(), nu_, command.data(), actuator_state_);
   }
 
   void shift_nominal() {
@@ -414,6 +478,7 @@ class Controller {
   std::span<const float> safe_output(StepSummary& sum,
                                      std::chrono::steady_clock::time_point start) {
     std::copy(options_.safe_control.begin(), options_.safe_control.end(), output_.begin());
+    sent(output_);
     sum.optimizer_ms = elapsed_ms(start);
     return output_;
   }
@@ -443,6 +508,10 @@ class Controller {
   std::vector<float> output_;         // nu
   std::vector<float> x0_;             // nx
   SavitzkyGolay smoother_;
+  NoiseFilter noise_filter_;          // the sampler (options_.sampler at dt_s)
+  float lambda_ = 1.f;                // the temperature of the next iteration
+  std::vector<ActuatorStep> actuator_steps_;  // options_.actuators at dt_s; empty = off
+  ActuatorState actuator_state_;
 };
 
 // A controller on the CPU backend for model D and cost C.

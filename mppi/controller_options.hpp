@@ -6,6 +6,10 @@
 #include <string>
 #include <vector>
 
+#include "mppi/actuator_chain.hpp"
+#include "mppi/adaptive_temperature.hpp"
+#include "mppi/sampler.hpp"
+
 namespace mppi {
 
 // How the CPU threads share an iteration's chunks of samples (mppi/thread_schedule.hpp).
@@ -31,6 +35,17 @@ struct ControllerOptions {
   std::uint64_t seed = 1;          // noise seed (draws depend on seed, step, sample, t, channel)
   int num_threads = 0;             // CPU threads; 0 = OpenMP default
   ThreadSchedule schedule = ThreadSchedule::kWorkStealing;  // how the CPU threads share the work
+
+  // How the perturbations are drawn along the horizon (mppi/sampler.hpp): white Gaussian (the
+  // paper's), low-pass or derivative-space (smooth).
+  SamplerOptions sampler;
+  // Adaptive temperature (mppi/adaptive_temperature.hpp): with ess_share > 0, lambda is set at
+  // every iteration so that the effective sample size is ess_share * K (within the tolerance
+  // and the bounds); `lambda` above is then only the first step's starting guess.
+  TemperatureTarget temperature;
+  // Actuator-aware planning (mppi/actuator_chain.hpp): the delay, rate limit and lag between
+  // each channel's command and the model's input; empty = the model takes the command directly.
+  std::vector<ActuatorChannel> actuators;
 
   // Checks against a model with `num_controls` channels; on failure writes why.
   bool is_valid(int num_controls, std::string* why) const {
@@ -65,6 +80,17 @@ struct ControllerOptions {
       if (smoothing_window > horizon) return fail("smoothing_window must be <= horizon");
     }
     if (num_threads < 0) return fail("num_threads must be >= 0");
+    if (!sampler_is_valid(sampler, dt_s, why)) return false;
+    if (temperature.ess_share != 0.f) {
+      if (!(temperature.ess_share > 0.f && temperature.ess_share <= 1.f))
+        return fail("temperature.ess_share must be in (0, 1] (0 = fixed temperature)");
+      if (!(temperature.lambda_min > 0.f && temperature.lambda_min < temperature.lambda_max) ||
+          !std::isfinite(temperature.lambda_max))
+        return fail("temperature bounds need 0 < lambda_min < lambda_max < inf");
+      if (!(temperature.tolerance > 0.f && temperature.tolerance < 1.f))
+        return fail("temperature.tolerance must be in (0, 1)");
+    }
+    if (!actuators_are_valid(actuators, num_controls, dt_s, why)) return false;
     return true;
   }
 };

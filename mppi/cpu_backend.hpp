@@ -20,6 +20,7 @@
 #include "base/batch.hpp"
 #include "base/error.hpp"
 #include "base/multiversion.hpp"
+#include "mppi/actuator_chain.hpp"
 #include "mppi/backend.hpp"
 #include "mppi/concepts.hpp"
 #include "mppi/noise.hpp"
@@ -70,6 +71,8 @@ struct IterationArgs {
   NoiseKey key;
   std::uint32_t iteration;
   int num_samples, padded, horizon;
+  NoiseFilter filter;
+  ActuatorPlan actuators;
 };
 
 // partial[r] = sum_j e[j] v[r * padded + j], j in [0, kChunk), for r in [0, rows): the chunk's
@@ -163,6 +166,8 @@ MPPI_MULTIVERSION void iterate_chunk(const D& model, const C& cost, const Iterat
   float* scratch = v + static_cast<std::size_t>(a.horizon) * Nu * W;
   alignas(64) float state_cost[W] = {};
   alignas(64) float control_cost[W] = {};
+  alignas(64) float eps_state[Nu * W];  // the sampler's state per channel and lane
+  alignas(64) float actuator_rate[Nu * W], actuator_lag[Nu * W], applied[Nu * W];
   for (int i = 0; i < D::kNx; ++i) std::fill_n(x + i * W, W, a.x0[i]);
   const float valid_lanes = static_cast<float>(a.num_samples - k0);
   for (int t = 0; t < a.horizon; ++t) {
@@ -170,10 +175,15 @@ MPPI_MULTIVERSION void iterate_chunk(const D& model, const C& cost, const Iterat
       const int steps = std::min(2, a.horizon - t);
       float* vt = v + static_cast<std::size_t>(t) * Nu * W;
       sample_step_pair<W>(a.key, a.iteration, k0, valid_lanes, t, steps, Nu, a.nominal + t * Nu,
-                          a.noise_std, a.lo, a.hi, a.gamma, vt, W, static_cast<std::size_t>(Nu) * W,
-                          control_cost);
+                          a.noise_std, a.lo, a.hi, a.gamma, a.filter, eps_state, vt, W,
+                          static_cast<std::size_t>(Nu) * W, control_cost);
     }
     const float* u = v + static_cast<std::size_t>(t) * Nu * W;
+    if (a.actuators.enabled()) {  // the model sees the actuators' output, not the command
+      detail::actuator_inputs<W>(a.actuators, Nu, t, v, W, static_cast<std::size_t>(Nu) * W,
+                                 actuator_rate, actuator_lag, applied);
+      u = applied;
+    }
     model.template step<W>(Batch<D::kNx, W>{x}, ConstBatch<Nu, W>{u}, a.dt_s, scratch);
     cost.template accumulate<D::kNx, Nu, W>(ConstBatch<D::kNx, W>{x}, ConstBatch<Nu, W>{u}, t,
                                             state_cost);
@@ -215,10 +225,11 @@ template <int W>
 MPPI_MULTIVERSION void regenerate_controls(const IterationArgs& a, int nu, int k0, float* v,
                                            std::size_t v_stride, std::size_t v_step_stride) noexcept {
   alignas(64) float control_cost[W] = {};  // summed as in iterate_chunk, not used
+  alignas(64) float eps_state[kMaxNoiseChannels * W];
   const float valid_lanes = static_cast<float>(a.num_samples - k0);
   for (int t = 0; t < a.horizon; t += 2)
     sample_step_pair<W>(a.key, a.iteration, k0, valid_lanes, t, std::min(2, a.horizon - t), nu,
-                        a.nominal + t * nu, a.noise_std, a.lo, a.hi, a.gamma,
+                        a.nominal + t * nu, a.noise_std, a.lo, a.hi, a.gamma, a.filter, eps_state,
                         v + static_cast<std::size_t>(t) * v_step_stride, v_stride, v_step_stride,
                         control_cost);
 }
@@ -285,6 +296,7 @@ class CpuBackend final : public Backend {
              ThreadSchedule schedule = ThreadSchedule::kDynamic)
       : model_(std::move(model)), cost_(std::move(cost)), dt_s_(dt_s), runner_(num_threads, schedule) {
     if (num_samples < 1 || horizon < 1) throw Error("CpuBackend: need num_samples, horizon >= 1");
+    static_assert(D::kNu <= detail::kMaxNoiseChannels, "the samplers filter at most kMaxNoiseChannels channels");
     shape_ = {num_samples, padded_sample_count(num_samples), horizon, D::kNx, D::kNu};
     threads_ = runner_.threads();
     // state, the chunk's T steps of controls (iterate_chunk; rollout_chunk uses one), model
@@ -328,13 +340,15 @@ class CpuBackend final : public Backend {
   // The whole iteration in one parallel pass over the chunks (detail::iterate_chunk), then
   // the chunks combined in order (detail::combine_chunks).
   bool has_iterate() const override { return true; }
+  bool supports_actuators() const override { return true; }
   void iterate(const IterationInput& in, IterationOutput& out) override {
     const int padded = shape_.padded_samples;
     const int chunks = padded / kChunk;
     const detail::IterationArgs args{in.x0.data(), in.nominal.data(), in.noise_std.data(),
                                      in.control_min.data(), in.control_max.data(), in.gamma,
                                      1.f / in.lambda, dt_s_, NoiseKey{in.seed}, in.iteration,
-                                     shape_.num_samples, padded, shape_.horizon};
+                                     shape_.num_samples, padded, shape_.horizon, in.noise_filter,
+                                     in.actuators};
     remember_draw_inputs(in);
     float* work = work_.data();
     const std::size_t work_floats = work_floats_;
@@ -429,13 +443,14 @@ class CpuBackend final : public Backend {
     drawn_gamma_ = in.gamma;
     drawn_key_ = NoiseKey{in.seed};
     drawn_iteration_ = in.iteration;
+    drawn_filter_ = in.noise_filter;
     drawn_ = true;
     controls_fresh_ = false;
   }
   detail::IterationArgs drawn_args() const {
     return {nullptr, drawn_nominal_.data(), drawn_std_.data(), drawn_lo_.data(), drawn_hi_.data(),
             drawn_gamma_, 0.f, dt_s_, drawn_key_, drawn_iteration_, shape_.num_samples,
-            shape_.padded_samples, shape_.horizon};
+            shape_.padded_samples, shape_.horizon, drawn_filter_, ActuatorPlan{}};
   }
 
   D model_;
@@ -458,6 +473,7 @@ class CpuBackend final : public Backend {
   float drawn_gamma_ = 0.f;
   NoiseKey drawn_key_{};
   std::uint32_t drawn_iteration_ = 0;
+  NoiseFilter drawn_filter_;
   std::size_t partial_stride_ = 0;
   std::vector<detail::ChunkTotals> totals_;
   std::vector<double> sums_, scales_;

@@ -18,6 +18,7 @@
 #include "costs/cost_config.hpp"
 #include "mppi/cost_map.hpp"
 #include "dynamics/corrected_model.hpp"
+#include "sim/actuator_model.hpp"
 #include "dynamics/with_effects.hpp"
 #include "dynamics/model_registry.hpp"
 #include "dynamics/four_wheel_observe.hpp"
@@ -253,7 +254,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   long control_step = 0;
 
   std::vector<float> model_x(static_cast<std::size_t>(setup.model_states));
-  std::vector<double> optimizer_ms, ess;
+  std::vector<double> optimizer_ms, ess, lambdas;
   std::vector<PathSample> path;
   std::vector<PathSample> slip_path;  // the same trail, value = |body slip| [deg]
   std::vector<double> abs_slip;
@@ -325,6 +326,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
     const Control command = chassis ? chassis->drive(output, t) : output;
     optimizer_ms.push_back(step_summary.optimizer_ms);
     ess.push_back(step_summary.effective_sample_size);
+    lambdas.push_back(step_summary.lambda);
     for (int i = 0; i < substeps; ++i) {
       plant.advance(command, static_cast<float>(config.plant_dt_s));
       t += config.plant_dt_s;
@@ -417,6 +419,16 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   double ess_sum = 0;
   for (double e : ess) ess_sum += e;
   summary.effective_sample_size_mean = ess.empty() ? 0.0 : ess_sum / ess.size();
+  summary.sampler = sampler_name(config.controller.sampler.kind);
+  summary.ess_target_share = config.controller.temperature.ess_share;
+  summary.lambda_p50 = percentile(lambdas, 50);
+  summary.actuator_model = config.actuator_model.empty() ? "none" : config.actuator_model;
+  if (summary.ess_target_share > 0 && !ess.empty()) {
+    const double want = summary.ess_target_share * config.controller.num_samples;
+    std::size_t in_band = 0;
+    for (double e : ess) in_band += std::abs(e / want - 1) <= 0.25;
+    summary.ess_in_band_share = static_cast<double>(in_band) / static_cast<double>(ess.size());
+  }
   if (log) {
     log->close();
     char title[256];
@@ -448,7 +460,11 @@ std::optional<SingleTrackParams> plant_vehicle_params(const ClosedLoopConfig& co
   }, "plant");
 }
 
-RunSummary run_closed_loop(const ClosedLoopConfig& config) {
+RunSummary run_closed_loop(const ClosedLoopConfig& given) {
+  ClosedLoopConfig config = given;
+  if (!config.actuator_model.empty() && config.actuator_model != "none")
+    config.controller.actuators =
+        resolve_actuator_model(config.actuator_model, config.plant, config.plant_params_yaml, config.actuators);
   TrackOptions track_options;
   track_options.direction = config.clockwise ? Direction::kClockwise : Direction::kCounterClockwise;
   const Track track = Track::load(config.track, track_options);

@@ -56,6 +56,10 @@ struct ClosedLoopConfig {
   // Needs the single-track plant.
   std::string surface_yaml;
   ActuatorLimits actuators;               // plant actuator limits
+  // The actuator chain the controller plans through (sim/actuator_model.hpp): "none", "plant"
+  // (the simulated car's own) or a corrected-model file; other than "none" it sets
+  // controller.actuators.
+  std::string actuator_model = "none";
   double plant_dt_s = 0.002;              // plant integration step (500 Hz)
   std::string out_dir;                    // log.csv, track.png, summary.json; empty = none
   bool progress = true;                   // print a line per lap to stderr

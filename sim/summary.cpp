@@ -47,6 +47,11 @@ std::string to_json(const RunSummary& s) {
   j["optimizer_ms_p50"] = number(s.optimizer_ms_p50);
   j["optimizer_ms_p99"] = number(s.optimizer_ms_p99);
   j["effective_sample_size_mean"] = number(s.effective_sample_size_mean);
+  j["sampler"] = s.sampler;
+  j["ess_target_share"] = number(s.ess_target_share);
+  j["ess_in_band_share"] = number(s.ess_in_band_share);
+  j["lambda_p50"] = number(s.lambda_p50);
+  j["actuator_model"] = s.actuator_model;
   j["backend"] = s.backend;
   j["failed_steps"] = s.failed_steps;
   j["backend_switches"] = nlohmann::ordered_json::array();

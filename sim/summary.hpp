@@ -47,6 +47,14 @@ struct RunSummary {
   double optimizer_ms_p50 = 0.0;      // wall time of one controller step, median
   double optimizer_ms_p99 = 0.0;
   double effective_sample_size_mean = 0.0;
+  // The controller's variant: its sampler (mppi/sampler.hpp), the adaptive temperature's target
+  // share of K (0 = fixed lambda) with the share of steps whose ESS was within +-25 % of it (NaN
+  // when fixed) and the median temperature, and the actuator chain it planned through.
+  std::string sampler = "gaussian";
+  double ess_target_share = 0.0;
+  double ess_in_band_share = std::numeric_limits<double>::quiet_NaN();
+  double lambda_p50 = 0.0;
+  std::string actuator_model = "none";
   std::string backend;                // the backend the run started on ("cpu", "vulkan")
   int failed_steps = 0;               // control steps that returned the safe control
   std::vector<BackendSwitchRecord> backend_switches;

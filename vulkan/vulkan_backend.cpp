@@ -39,12 +39,14 @@ struct StepUbo {
   float control_min[4];
   float control_max[4];
   float x0[kMaxStates];
+  float noise_filter[4];   // carry, first gain, gain, white (1) or not (0)
 };
 // The std140 offsets of StepBlock: uvec4/vec4 members at 16-byte steps, x0 as vec4[4].
 static_assert(offsetof(StepUbo, seed) == 16 && offsetof(StepUbo, scalars) == 32 &&
               offsetof(StepUbo, noise_std) == 48 && offsetof(StepUbo, control_min) == 64 &&
               offsetof(StepUbo, control_max) == 80 && offsetof(StepUbo, x0) == 96 &&
-              sizeof(StepUbo) == 96 + 4 * kMaxStates, "StepUbo must mirror StepBlock (std140)");
+              offsetof(StepUbo, noise_filter) == 96 + 4 * kMaxStates &&
+              sizeof(StepUbo) == 112 + 4 * kMaxStates, "StepUbo must mirror StepBlock (std140)");
 
 void check(VkResult r, const char* what) {
   if (r != VK_SUCCESS)
@@ -435,6 +437,7 @@ VulkanBackend::VulkanBackend(const TwinModel& model, const AutoRallyCost& cost, 
     s.control_max[c] = 1.f;
   }
   s.scalars[2] = 1.f;
+  s.noise_filter[3] = 1.f;
   m.submit(m.cmd_iterate);
   m.submit(m.cmd_rollout);
 }
@@ -459,6 +462,10 @@ void VulkanBackend::iterate(const IterationInput& in, IterationOutput& out) {
   s.seed[1] = static_cast<std::uint32_t>(in.seed >> 32);
   s.scalars[1] = in.gamma;
   s.scalars[2] = 1.f / in.lambda;
+  s.noise_filter[0] = in.noise_filter.carry;
+  s.noise_filter[1] = in.noise_filter.first_gain;
+  s.noise_filter[2] = in.noise_filter.gain;
+  s.noise_filter[3] = in.noise_filter.white() ? 1.f : 0.f;
   for (int c = 0; c < kNu; ++c) {
     s.noise_std[c] = in.noise_std[c];
     s.control_min[c] = in.control_min[c];

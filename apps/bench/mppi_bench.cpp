@@ -5,6 +5,11 @@
 //                                update (AutoRally network, AutoRallyCost on the Gazebo cost map,
 //                                K = 1920, T = 100, 1 iteration); B = 1: the network's hidden
 //                                layers in bf16 (AutoRallyNetwork::set_precision), 0: FP32
+//   BM_VariantIteration/threads:N/variant:V  the same step for each controller variant, to be
+//                                read as a ratio to variant 0 of the same run: 0 plain, 1 low-pass
+//                                sampling, 2 derivative-space (smooth) sampling, 3 adaptive
+//                                temperature (ESS 10 % of K), 4 actuator-aware (steering delay
+//                                0.04 s, lag 0.1 s, 5/s; throttle 10/s)
 //   BM_MppiContention/threads:N/busy:B/schedule:S  the same step while B busy processes (started
 //                                and stopped by the benchmark) share the CPU; S: 0 work stealing
 //                                (oneTBB, the default), 1 OpenMP dynamic, 2 OpenMP static
@@ -154,6 +159,32 @@ void BM_MppiIteration(benchmark::State& state) {
   state.counters["min_cost"] = summary.min_cost;
   state.counters["ess"] = summary.effective_sample_size;
   state.counters["valid"] = summary.valid_samples;
+  if (summary.status != mppi::StepStatus::kOk) state.SkipWithError(summary.reason);
+}
+
+// One controller.step(x0) of a controller variant (see the list at the top).
+void BM_VariantIteration(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  mppi::ControllerOptions o = options(threads);
+  switch (state.range(1)) {
+    case 1: o.sampler.kind = mppi::SamplerKind::kLowPass; break;
+    case 2: o.sampler.kind = mppi::SamplerKind::kSmooth; break;
+    case 3: o.temperature.ess_share = 0.1f; break;
+    case 4: o.actuators = {{0.04f, 0.1f, 5.f}, {0.f, 0.f, 10.f}}; break;
+    default: break;
+  }
+  mppi::Controller controller = mppi::make_cpu_controller(network(), make_cost(), o);
+  const std::vector<float> x0 = model_state(network(), start_state());
+  mppi::StepSummary summary;
+  for (int i = 0; i < 3; ++i) controller.step(x0, &summary);  // warm caches and thread pool
+  for (auto _ : state) {
+    auto u = controller.step(x0, &summary);
+    benchmark::DoNotOptimize(u.data());
+    benchmark::ClobberMemory();
+  }
+  set_rate_counters(state, threads);
+  state.counters["ess"] = summary.effective_sample_size;
+  state.counters["lambda"] = summary.lambda;
   if (summary.status != mppi::StepStatus::kOk) state.SkipWithError(summary.reason);
 }
 
@@ -366,6 +397,11 @@ void thread_precision_args(benchmark::internal::Benchmark* b) {
   b->ArgNames({"threads", "bf16"})->ArgsProduct({{1, 2}, {0, 1}})->UseRealTime()->Unit(benchmark::kMillisecond);
 }
 BENCHMARK(BM_MppiIteration)->Apply(thread_precision_args);
+BENCHMARK(BM_VariantIteration)
+    ->ArgNames({"threads", "variant"})
+    ->ArgsProduct({{1, 2}, {0, 1, 2, 3, 4}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 // threads x busy processes x schedule (0 work stealing, 1 OpenMP dynamic, 2 OpenMP static)
 BENCHMARK(BM_MppiContention)
     ->ArgNames({"threads", "busy", "schedule"})

@@ -206,3 +206,36 @@ def test_run_closed_loop_releases_the_gil():
     summary, counts = run_counting_main_thread(lambda: mppi.run_closed_loop(config))
     assert summary.sim_time_s == pytest.approx(4.0, abs=0.05)
     assert counts > 0  # 0 exactly when the call holds the GIL (gil_check.py)
+
+
+def test_controller_variants_from_python():
+    """The sampler, the adaptive temperature and the actuator chain are settable from Python and
+    do what they say: the smooth sampler's draws change less from step to step than the Gaussian's,
+    the temperature holds the effective sample size at its target, and a bad setting is refused."""
+    cmap = mppi.CostMap.load_npz(os.path.join(DATA, "autorally/maps/gazebo/gazebo_costmap.npz"))
+    cost = mppi.AutoRallyCost(cmap)
+
+    def draws_step_change(kind):
+        o = mppi.ControllerOptions()
+        o.num_samples = 256
+        o.num_threads = 1
+        o.sampler.kind = kind
+        o.temperature.ess_share = 0.1
+        o.actuators = [mppi.ActuatorChannel(delay_s=0.04, lag_s=0.1, rate_per_s=5.0),
+                       mppi.ActuatorChannel(rate_per_s=10.0)]
+        c = mppi.Controller("single-track", cost, o)
+        x = c.model_state(mppi.VehicleState(x_m=-8.5, y_m=-8.9, yaw_rad=2.356, vx_mps=5.0))
+        u, s = c.step(x)
+        assert s.status == mppi.StepStatus.OK
+        assert abs(s.effective_sample_size / 25.6 - 1) <= 0.1 + 1e-3
+        assert s.lambda_ > 0
+        v = c.sampled_controls  # T x nu x K
+        assert v.shape == (100, 2, 256)
+        steer = v[:, 0, :]
+        return float(np.mean(np.abs(np.diff(steer, axis=0))))
+
+    assert draws_step_change(mppi.SamplerKind.SMOOTH) < 0.5 * draws_step_change(mppi.SamplerKind.GAUSSIAN)
+    o = mppi.ControllerOptions()
+    o.actuators = [mppi.ActuatorChannel(delay_s=-1.0), mppi.ActuatorChannel()]
+    with pytest.raises(mppi.Error, match="delay_s"):
+        mppi.Controller("single-track", cost, o)

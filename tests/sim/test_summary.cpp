@@ -60,8 +60,17 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.peak_slip_angle_rad = 0.25;
   s.p95_slip_angle_rad = 0.125;
   s.peak_lateral_accel_mps2 = 6.5;
+  s.sampler = "smooth";
+  s.ess_target_share = 0.125;
+  s.lambda_p50 = 3.5;
+  s.actuator_model = "plant";
   const auto j = nlohmann::json::parse(to_json(s));
-  CHECK(j.size() == 28);
+  CHECK(j.size() == 33);
+  CHECK(j.at("sampler") == "smooth");
+  CHECK(j.at("ess_target_share") == 0.125);
+  CHECK(j.at("ess_in_band_share").is_null());  // NaN: a fixed temperature
+  CHECK(j.at("lambda_p50") == 3.5);
+  CHECK(j.at("actuator_model") == "plant");
   CHECK(j.at("track") == "gazebo");
   CHECK(j.at("model") == "nn_autorally");
   CHECK(j.at("plant") == "single_track");

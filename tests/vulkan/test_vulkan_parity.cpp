@@ -34,8 +34,9 @@ const mppi::AutoRallyCost& gazebo_cost() {
   return cost;
 }
 
-mppi::ControllerOptions parity_options(int k, int t) {
+mppi::ControllerOptions parity_options(int k, int t, mppi::SamplerKind sampler) {
   mppi::ControllerOptions o;
+  o.sampler.kind = sampler;
   o.num_samples = k;
   o.horizon = t;
   o.gamma = 0.1f;  // exercise the control cost too
@@ -72,8 +73,9 @@ struct Worst {
 // crash_weight * crash_discount^t in its cost), so the per-sample costs are checked by their
 // 99th percentile: at most 1% of the samples may differ by more than 1e-3.
 template <class D>
-Worst compare(const D& model, int device, int k, int t) {
-  const mppi::ControllerOptions o = parity_options(k, t);
+Worst compare(const D& model, int device, int k, int t,
+              mppi::SamplerKind sampler = mppi::SamplerKind::kGaussian) {
+  const mppi::ControllerOptions o = parity_options(k, t, sampler);
   mppi::Controller cpu = mppi::make_cpu_controller(model, gazebo_cost(), o);
   std::string why;
   const auto twin = mppi::vulkan::twin_of(model, &why);
@@ -136,6 +138,22 @@ void check_parity(const D& model, const char* name) {
 }
 
 }  // namespace
+
+TEST_CASE("Vulkan parity: the low-pass and smooth samplers draw the CPU's numbers", "[vulkan][parity][sampler]") {
+  const int device = mppi::test::vulkan_test_device();
+  if (device < 0) return;
+  for (auto kind : {mppi::SamplerKind::kLowPass, mppi::SamplerKind::kSmooth}) {
+    const Worst w = compare(mppi::KinematicBicycle{}, device, 1000, 500, kind);
+    INFO(mppi::sampler_name(kind) << ": worst cost rel. diff " << w.cost_rel << " (99th percentile "
+                                  << w.cost_rel_p99 << "), first-control diff " << w.control
+                                  << ", sampled-control diff " << w.sampled << " (first step " << w.sampled_first << ")");
+    // The recursion carries last-bit differences (FMA) along 500 steps: a few ulp of eps.
+    CHECK(w.sampled_first <= 1e-5);
+    CHECK(w.sampled <= 1e-4);
+    CHECK(w.cost_rel_p99 <= 1e-3);
+    CHECK(w.control <= 1e-4);
+  }
+}
 
 TEST_CASE("Vulkan parity: kinematic bicycle, AutoRally cost", "[vulkan][parity]") {
   check_parity(mppi::KinematicBicycle{}, "kinematic");

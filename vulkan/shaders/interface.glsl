@@ -11,6 +11,7 @@ layout(std140, set = 0, binding = 0) uniform StepBlock {
   vec4 control_min;   // per control channel
   vec4 control_max;   // per control channel
   vec4 x0[4];         // start state, up to 16 entries
+  vec4 noise_filter;  // the sampler's recursion (mppi/sampler.hpp): carry, first gain, gain, white (1/0)
 } step_data;
 
 layout(std430, set = 0, binding = 1) readonly buffer Nominal { float nominal[]; };   // T x nu

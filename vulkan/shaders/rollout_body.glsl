@@ -19,6 +19,13 @@ void main() {
   precise float cost = 0.0;
   precise float control_cost = 0.0;
   uvec4 words = uvec4(0u);
+  // the sampler: eps_0 = first_gain n_0, eps_t = carry eps_{t-1} + gain n_t (white: eps = n)
+  bool white = step_data.noise_filter.w != 0.0;
+  precise float carry = step_data.noise_filter.x;
+  precise float first_gain = step_data.noise_filter.y;
+  precise float gain = step_data.noise_filter.z;
+  float eps[NU];
+  [[unroll]] for (int ch = 0; ch < NU; ++ch) eps[ch] = 0.0;
   for (int t = 0; t < horizon; ++t) {
     float u[NU];
     if (kGenerate) {
@@ -29,6 +36,13 @@ void main() {
         philox4x32_10(words, step_data.seed.x, step_data.seed.y);
       }
       vec2 n = (t & 1) == 0 ? box_muller(words.x, words.y) : box_muller(words.z, words.w);
+      if (!white) {
+        [[unroll]] for (int ch = 0; ch < NU; ++ch) {
+          precise float e = t == 0 ? first_gain * n[ch] : carry * eps[ch] + gain * n[ch];
+          eps[ch] = e;
+          n[ch] = e;
+        }
+      }
       [[unroll]] for (int ch = 0; ch < NU; ++ch) {
         precise float un = nominal[t * NU + ch];
         precise float sd = step_data.noise_std[ch];
