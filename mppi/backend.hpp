@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "mppi/actuator_chain.hpp"
+#include "mppi/ancillary.hpp"
 #include "mppi/cost_map.hpp"
 #include "mppi/sampler.hpp"
 
@@ -100,6 +101,20 @@ class Backend {
   }
   virtual bool set_cost_map(std::shared_ptr<const CostMap> /*map*/, std::string* why) {
     if (why) *why = std::string(name()) + " backend: its cost map cannot change while it runs";
+    return false;
+  }
+
+  // The ancillary feedback of Tube-MPPI / Robust MPPI along a plan: rolls `nominal` (T x nu)
+  // out from x0 (num_states) into states_out ((T+1) x nx: x0 .. x_T) and writes the
+  // time-varying LQR gains of the model linearised along it into gains_out (T x nu x nx,
+  // row-major), so that u_t = nominal_t + K_t (x_t - states_out_t); see mppi/lqr.hpp. False
+  // with the reason in *why (naming the argument) if a size is wrong, an input is not finite,
+  // the weights do not fit, the recursion fails, or this backend cannot linearise its model.
+  // Called between iterations, from the thread that steps the controller.
+  virtual bool ancillary_gains(std::span<const float> /*x0*/, std::span<const float> /*nominal*/,
+                               const AncillaryWeights& /*w*/, std::span<float> /*states_out*/,
+                               std::span<float> /*gains_out*/, std::string* why) {
+    if (why) *why = std::string(name()) + " backend cannot linearise its model";
     return false;
   }
 };

@@ -11,6 +11,7 @@
 #include <limits>
 #include <memory>
 #include <new>
+#include <string>
 #include <vector>
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -23,6 +24,8 @@
 #include "mppi/actuator_chain.hpp"
 #include "mppi/backend.hpp"
 #include "mppi/concepts.hpp"
+#include "mppi/linearize.hpp"
+#include "mppi/lqr.hpp"
 #include "mppi/noise.hpp"
 #include "mppi/sample_step.hpp"
 #include "mppi/thread_schedule.hpp"
@@ -477,6 +480,71 @@ class CpuBackend final : public Backend {
   std::size_t partial_stride_ = 0;
   std::vector<detail::ChunkTotals> totals_;
   std::vector<double> sums_, scales_;
+
+  // ---- the ancillary feedback: the model linearised along the plan (mppi/linearize.hpp) and
+  // the time-varying LQR on it (mppi/lqr.hpp)
+ public:
+  bool ancillary_gains(std::span<const float> x0, std::span<const float> nominal,
+                       const AncillaryWeights& w, std::span<float> states_out,
+                       std::span<float> gains_out, std::string* why) override {
+    constexpr int Nx = D::kNx, Nu = D::kNu;
+    const int T = shape_.horizon;
+    auto fail = [&](const std::string& reason) {
+      if (why) *why = std::string(name()) + " backend: ancillary gains: " + reason;
+      return false;
+    };
+    auto size_error = [&](const char* arg, std::size_t got, std::size_t need, const char* layout) {
+      return fail(std::string(arg) + " has " + std::to_string(got) + " floats, need " + layout + " = " +
+                  std::to_string(need));
+    };
+    const auto t_count = static_cast<std::size_t>(T);
+    if (x0.size() != Nx) return size_error("x0", x0.size(), Nx, "num_states");
+    if (nominal.size() != t_count * Nu) return size_error("nominal", nominal.size(), t_count * Nu, "T x nu");
+    if (states_out.size() != (t_count + 1) * Nx)
+      return size_error("states_out", states_out.size(), (t_count + 1) * Nx, "(T+1) x nx");
+    if (gains_out.size() != t_count * Nu * Nx)
+      return size_error("gains_out", gains_out.size(), t_count * Nu * Nx, "T x nu x nx");
+    for (std::size_t i = 0; i < x0.size(); ++i)
+      if (!std::isfinite(x0[i])) return fail("x0[" + std::to_string(i) + "] is not finite");
+    for (std::size_t i = 0; i < nominal.size(); ++i)
+      if (!std::isfinite(nominal[i]))
+        return fail("nominal[" + std::to_string(i) + "] (t = " + std::to_string(i / Nu) + ") is not finite");
+    std::string reason;  // empty (no allocation) unless a check fails
+    if (!check_ancillary_weights(w, Nx, Nu, &reason)) return fail(reason);
+    if (ancillary_.scratch.empty()) {  // first call: everything the later calls need
+      ancillary_.scratch.assign(linearize_scratch_floats(model_), 0.f);
+      ancillary_.a.assign(t_count * Nx * Nx, 0.f);
+      ancillary_.b.assign(t_count * Nx * Nu, 0.f);
+      ancillary_.q.assign(Nx, 0.f);
+      ancillary_.qf.assign(Nx, 0.f);
+      ancillary_.r.assign(Nu, 0.f);
+      ancillary_.lqr.resize(Nx, Nu);
+    }
+    linearize_along(model_, x0.data(), nominal.data(), T, dt_s_, states_out.data(), ancillary_.a.data(),
+                    ancillary_.b.data(), ancillary_.scratch.data());
+    for (std::size_t i = 0; i < states_out.size(); ++i)
+      if (!std::isfinite(states_out[i]))
+        return fail("the rollout of the nominal is not finite at t = " + std::to_string(i / Nx));
+    for (int i = 0; i < Nx; ++i) {
+      ancillary_.q[i] = w.q_diag.empty() ? 1.f : w.q_diag[i];
+      ancillary_.qf[i] = w.terminal_scale * ancillary_.q[i];
+    }
+    for (int c = 0; c < Nu; ++c) ancillary_.r[c] = w.r_diag.empty() ? 1.f : w.r_diag[c];
+    const LqrProblem<float> problem{T, Nx, Nu, ancillary_.a, ancillary_.b, ancillary_.q, ancillary_.r,
+                                    ancillary_.qf};
+    if (!solve_lqr(problem, ancillary_.lqr, gains_out, &reason)) return fail(reason);
+    return true;
+  }
+
+ private:
+  // ancillary_gains(): sized on its first call, reused after (no allocation then).
+  struct AncillaryWork {
+    std::vector<float> scratch;   // linearize_scratch_floats(model_)
+    std::vector<float> a, b;      // T x nx x nx, T x nx x nu
+    std::vector<float> q, qf, r;  // the weights' diagonals
+    LqrWorkspace lqr;
+  };
+  AncillaryWork ancillary_;
 };
 
 }  // namespace mppi
