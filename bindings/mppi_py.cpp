@@ -182,6 +182,22 @@ PYBIND11_MODULE(mppi, m) {
       .def_readwrite("num_threads", &mppi::ControllerOptions::num_threads)
       .def_readwrite("sampler", &mppi::ControllerOptions::sampler)
       .def_readwrite("temperature", &mppi::ControllerOptions::temperature)
+      .def_property("variant",
+                    [](const mppi::ControllerOptions& o) { return std::string(mppi::variant_name(o.variant)); },
+                    [](mppi::ControllerOptions& o, const std::string& name) {
+                      if (!mppi::parse_controller_variant(name, &o.variant))
+                        throw mppi::Error("variant must be plain, tube or robust, got '" + name + "'");
+                    }, "plain | tube | robust")
+      .def_readwrite("tube_reset_distance", &mppi::ControllerOptions::tube_reset_distance)
+      .def_readwrite("robust_cost_margin", &mppi::ControllerOptions::robust_cost_margin)
+      .def_property("ancillary_q",
+                    [](const mppi::ControllerOptions& o) { return o.ancillary.q_diag; },
+                    [](mppi::ControllerOptions& o, const std::vector<float>& q) { o.ancillary.q_diag = q; },
+                    "tube / robust: the feedback's state weights (empty: 1 each)")
+      .def_property("ancillary_r",
+                    [](const mppi::ControllerOptions& o) { return o.ancillary.r_diag; },
+                    [](mppi::ControllerOptions& o, const std::vector<float>& r) { o.ancillary.r_diag = r; },
+                    "tube / robust: the feedback's control weights (empty: 1 each)")
       .def_readwrite("actuators", &mppi::ControllerOptions::actuators,
                      "list of ActuatorChannel, one per control channel (empty: none)")
       .def("is_valid", [](const mppi::ControllerOptions& o, int num_controls) {
@@ -205,6 +221,9 @@ PYBIND11_MODULE(mppi, m) {
       .def_readonly("valid_samples", &mppi::StepSummary::valid_samples)
       .def_readonly("iterations", &mppi::StepSummary::iterations)
       .def_readonly("lambda_", &mppi::StepSummary::lambda, "temperature of the weights")
+      .def_readonly("tube_distance", &mppi::StepSummary::tube_distance)
+      .def_readonly("nominal_reset", &mppi::StepSummary::nominal_reset)
+      .def_readonly("feedback_applied", &mppi::StepSummary::feedback_applied)
       .def_readonly("optimizer_ms", &mppi::StepSummary::optimizer_ms);
 
   py::class_<mppi::VehicleState>(m, "VehicleState", "common vehicle state (ISO 8855, SI units)")
@@ -383,6 +402,18 @@ PYBIND11_MODULE(mppi, m) {
           std::copy_n(v.begin() + static_cast<std::ptrdiff_t>(r * padded), k, out + r * k);
         return a;
       }, "the last iteration's sampled control sequences, T x num_controls x K")
+      .def_property_readonly("feedback_gains", [](const PyController& c) {
+        const auto g = c.controller->feedback_gains();
+        FloatArray a({static_cast<int>(g.size() / std::max(1, c.nu * c.nx)), c.nu, c.nx});
+        std::copy(g.begin(), g.end(), a.mutable_data());
+        return a;
+      }, "tube / robust: the last step's gains along the plan, T x num_controls x num_states (u = u_nom + K dx)")
+      .def_property_readonly("nominal_states", [](const PyController& c) {
+        const auto x = c.controller->nominal_states();
+        FloatArray a({static_cast<int>(x.size() / std::max(1, c.nx)), c.nx});
+        std::copy(x.begin(), x.end(), a.mutable_data());
+        return a;
+      }, "tube / robust: the last plan's states from the nominal state, (T + 1) x num_states")
       .def_property_readonly("sampled_costs", [](const PyController& c) { return to_array(c.controller->sampled_costs()); })
       .def_property_readonly("weights", [](const PyController& c) { return to_array(c.controller->weights()); });
 
@@ -448,6 +479,8 @@ PYBIND11_MODULE(mppi, m) {
       .def_readonly("ess_in_band_share", &Sum::ess_in_band_share)
       .def_readonly("lambda_p50", &Sum::lambda_p50)
       .def_readonly("actuator_model", &Sum::actuator_model)
+      .def_readonly("variant", &Sum::variant)
+      .def_readonly("nominal_resets", &Sum::nominal_resets)
       .def("to_json", [](const Sum& s) { return mppi::sim::to_json(s); });
 
   m.def("run_closed_loop", [](const Cfg& config) {

@@ -93,6 +93,31 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
   add_float_option(app, "--lambda-max", mppi.temperature.lambda_max, "adaptive temperature: highest lambda")
       ->type_name("L")
       ->check(CLI::PositiveNumber);
+  app.add_option_function<std::string>(
+         "--variant", [&mppi](const std::string& name) { parse_controller_variant(name, &mppi.variant); },
+         "plain (plans from the measured state) | tube (Tube-MPPI: plans from a nominal state, LQR feedback "
+         "on the error) | robust (Robust MPPI's choice of the nominal state, the same feedback)")
+      ->type_name("NAME")
+      ->check(CLI::IsMember({"plain", "tube", "robust"}).name("VARIANT").description(""))
+      ->default_str(variant_name(mppi.variant));
+  add_float_option(app, "--tube-reset", mppi.tube_reset_distance,
+                   "tube / robust: the Q-weighted distance of the measured state from the nominal one that puts "
+                   "the nominal state back on it")
+      ->type_name("D")
+      ->check(CLI::PositiveNumber);
+  add_float_option(app, "--robust-margin", mppi.robust_cost_margin,
+                   "robust: how much more the plan may cost from the measured state than from the nominal one "
+                   "for the measured state to be taken [cost units]")
+      ->type_name("C")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--ancillary-q", mppi.ancillary.q_diag,
+                 "tube / robust: the feedback's state weights, one per model state (default: 1 each)")
+      ->type_name("Q,...")
+      ->delimiter(',');
+  app.add_option("--ancillary-r", mppi.ancillary.r_diag,
+                 "tube / robust: the feedback's control weights, one per control (default: 1 each)")
+      ->type_name("R,...")
+      ->delimiter(',');
   app.add_option("--actuator-model", c.actuator_model,
                  "the actuators the controller plans through (delay, rate limit, lag per channel): none | plant "
                  "(the simulated car's own) | a corrected-model FILE (mppi-fit diagnose)")

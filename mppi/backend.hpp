@@ -117,6 +117,15 @@ class Backend {
     if (why) *why = std::string(name()) + " backend cannot linearise its model";
     return false;
   }
+  // True if ancillary_gains() and plan_cost() work (Tube-MPPI and Robust MPPI need them).
+  virtual bool supports_feedback() const { return false; }
+  // The running cost of one control sequence `plan` (T x nu) rolled out from x0, into *cost.
+  // False with the reason in *why if this backend cannot, or a size is wrong.
+  virtual bool plan_cost(std::span<const float> /*x0*/, std::span<const float> /*plan*/, float* /*cost*/,
+                         std::string* why) {
+    if (why) *why = std::string(name()) + " backend cannot cost a single plan";
+    return false;
+  }
 };
 
 }  // namespace mppi

@@ -53,6 +53,11 @@ struct StepSummary {
   int valid_samples = 0;             // samples with a finite cost (last iteration)
   int iterations = 0;                // iterations run
   float lambda = 0.f;                // temperature of the weights (last iteration)
+  // Tube / robust variants: the distance sqrt(dx' Q dx) of the measured state from the nominal
+  // one, and whether the nominal state was put back on the measured one this step.
+  float tube_distance = 0.f;
+  bool nominal_reset = false;
+  bool feedback_applied = false;     // the ancillary gains were computed and applied
   double optimizer_ms = 0.0;         // wall time of step()
 };
 
@@ -126,6 +131,21 @@ class Controller {
       smoother_ = SavitzkyGolay(options_.horizon, options_.smoothing_window, options_.smoothing_order);
     noise_filter_ = make_noise_filter(options_.sampler, options_.dt_s);
     lambda_ = options_.lambda;
+    if (options_.variant != ControllerVariant::kPlain) {
+      if (!backend_->supports_feedback())
+        throw Error(std::string("ControllerOptions: the ") + variant_name(options_.variant) +
+                    " variant needs a backend that linearises its model (the CPU backend); the " +
+                    backend_->name() + " backend does not");
+      if (!check_ancillary_weights(options_.ancillary, nx_, nu_, &why)) throw Error("ControllerOptions: " + why);
+      nominal_state_.assign(nx_, 0.f);
+      measured_.assign(nx_, 0.f);
+      nominal_states_.assign(static_cast<std::size_t>(options_.horizon + 1) * nx_, 0.f);
+      gains_.assign(static_cast<std::size_t>(options_.horizon) * nu_ * nx_, 0.f);
+      // size the backend's work for the feedback now, so that step() allocates nothing
+      float unused = 0.f;
+      backend_->ancillary_gains(nominal_state_, nominal_, options_.ancillary, nominal_states_, gains_, nullptr);
+      backend_->plan_cost(nominal_state_, nominal_, &unused, nullptr);
+    }
     if (!options_.actuators.empty()) {
       if (!backend_->supports_actuators())
         throw Error(std::string("ControllerOptions: actuator-aware planning needs a backend that rolls out "
@@ -155,6 +175,7 @@ class Controller {
       return safe_output(sum, start);
     }
     std::copy(x0.begin(), x0.end(), x0_.begin());
+    if (feedback()) choose_nominal_state(sum);
     try {
       for (int it = 0; it < options_.iterations; ++it) {
         const auto iteration = static_cast<std::uint32_t>(step_index_ * options_.iterations + it);
@@ -181,6 +202,7 @@ class Controller {
         return safe_output(sum, start);
       }
     }
+    if (feedback()) apply_feedback(sum);
     sent(output_);
     shift_nominal();
     ++step_index_;
@@ -231,7 +253,18 @@ class Controller {
     reset_plan();
     step_index_ = 0;
     actuator_state_ = ActuatorState{};
+    have_nominal_state_ = false;
   }
+
+  // Tube / robust variants: the plan's states from the nominal state ((T + 1) x nx) and the
+  // feedback gains along it (T x nu x nx, u_t = u_nom_t + K_t (x_t - x_nom_t)) of the last
+  // step, published with the plan (as AutoRally's plant publishes its DDP gains) so that a
+  // loop on the chassis can apply them between plans. Empty for the plain controller. The
+  // plan they belong to is the one before the shift: nominal() after the step holds it from
+  // t = 1 on.
+  std::span<const float> nominal_states() const { return nominal_states_; }
+  std::span<const float> feedback_gains() const { return gains_; }
+  std::span<const float> nominal_state() const { return nominal_state_; }
 
   // The actuator chain's state (options().actuators): the commands sent but not yet acting and
   // the rate limiter's and the lag's outputs. step() advances it with every command it returns;
@@ -306,6 +339,66 @@ class Controller {
   }
 
   bool adaptive() const { return options_.temperature.ess_share > 0.f; }
+  bool feedback() const { return options_.variant != ControllerVariant::kPlain; }
+
+  // sqrt((a - b)' Q (a - b)) with the ancillary Q (identity when not given).
+  float weighted_distance(const float* a, const float* b) const {
+    double d2 = 0.0;
+    for (int i = 0; i < nx_; ++i) {
+      const double q = options_.ancillary.q_diag.empty() ? 1.0 : options_.ancillary.q_diag[i];
+      d2 += q * (static_cast<double>(a[i]) - b[i]) * (static_cast<double>(a[i]) - b[i]);
+    }
+    return static_cast<float>(std::sqrt(d2));
+  }
+
+  // The state the iterations plan from (x0_ on return): the nominal state, or the measured
+  // one where the variant's rule puts the nominal state back on it.
+  void choose_nominal_state(StepSummary& sum) noexcept {
+    bool reset = !have_nominal_state_;
+    if (!reset) {
+      sum.tube_distance = weighted_distance(x0_.data(), nominal_state_.data());
+      reset = !(sum.tube_distance <= options_.tube_reset_distance);
+    }
+    if (!reset && options_.variant == ControllerVariant::kRobust) {
+      // Robust MPPI: the measured state unless the plan costs more from it than from the
+      // nominal state (by more than the margin); a backend error keeps the nominal state.
+      float cost_measured = 0.f, cost_nominal = 0.f;
+      try {
+        if (backend_->plan_cost(x0_, nominal_, &cost_measured, nullptr) &&
+            backend_->plan_cost(nominal_state_, nominal_, &cost_nominal, nullptr))
+          reset = !(cost_measured > cost_nominal + options_.robust_cost_margin);
+      } catch (...) {
+      }
+    }
+    if (reset) std::copy(x0_.begin(), x0_.end(), nominal_state_.begin());
+    sum.nominal_reset = reset;
+    measured_.assign(x0_.begin(), x0_.end());  // capacity nx: no allocation after the first step
+    std::copy(nominal_state_.begin(), nominal_state_.end(), x0_.begin());
+    have_nominal_state_ = true;
+  }
+
+  // output_ <- clamp(u_nom_0 + K_0 (x - x_nom)); the nominal state moves on under u_nom_0. If
+  // the gains cannot be formed, u_nom_0 goes out and the next step plans from the measured state.
+  void apply_feedback(StepSummary& sum) noexcept {
+    bool ok = false;
+    try {
+      ok = backend_->ancillary_gains(nominal_state_, nominal_, options_.ancillary, nominal_states_, gains_, nullptr);
+    } catch (...) {
+    }
+    if (!ok) {
+      have_nominal_state_ = false;
+      return;
+    }
+    for (int c = 0; c < nu_; ++c) {
+      double u = output_[c];
+      for (int i = 0; i < nx_; ++i)
+        u += static_cast<double>(gains_[static_cast<std::size_t>(c) * nx_ + i]) * (measured_[i] - nominal_state_[i]);
+      const auto uc = static_cast<float>(u);
+      if (std::isfinite(uc)) output_[c] = std::clamp(uc, options_.control_min[c], options_.control_max[c]);
+    }
+    std::copy_n(nominal_states_.begin() + nx_, nx_, nominal_state_.begin());
+    sum.feedback_applied = true;
+  }
 
   // weights_ <- exp(-(S_k - min_cost) / lambda) / eta over costs_ (0 where not finite);
   // returns the effective sample size 1 / sum w^2.
@@ -512,6 +605,12 @@ class Controller {
   float lambda_ = 1.f;                // the temperature of the next iteration
   std::vector<ActuatorStep> actuator_steps_;  // options_.actuators at dt_s; empty = off
   ActuatorState actuator_state_;
+  // tube / robust variants
+  std::vector<float> nominal_state_;   // nx: the state the next step plans from
+  bool have_nominal_state_ = false;    // false: the next step starts it at the measured state
+  std::vector<float> measured_;        // nx: this step's measured state
+  std::vector<float> nominal_states_;  // (T + 1) x nx along the last plan
+  std::vector<float> gains_;           // T x nu x nx
 };
 
 // A controller on the CPU backend for model D and cost C.

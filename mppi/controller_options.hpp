@@ -8,6 +8,7 @@
 
 #include "mppi/actuator_chain.hpp"
 #include "mppi/adaptive_temperature.hpp"
+#include "mppi/ancillary.hpp"
 #include "mppi/sampler.hpp"
 
 namespace mppi {
@@ -18,6 +19,29 @@ namespace mppi {
 // cores to the working ones (measured: docs/BENCHMARKS.md, contention). kDynamic / kStatic:
 // OpenMP with dynamic or static chunks. Results do not depend on it.
 enum class ThreadSchedule { kWorkStealing, kDynamic, kStatic };
+
+// Which MPPI (docs/CONTROLLER.md):
+//   kPlain   plans from the measured state (the paper's).
+//   kTube    Tube-MPPI (Williams et al. 2018): plans from a nominal state that follows the
+//            model under the plan, and sends u = u_nom + K (x - x_nom) with the time-varying
+//            LQR gains K along the plan (ancillary); the nominal state is put back on the
+//            measured one when their weighted distance exceeds tube_reset_distance.
+//   kRobust  Robust MPPI's choice of the nominal state (Gandhi et al. 2021): at every step the
+//            measured state replaces the nominal one unless the plan costs more from it than
+//            from the nominal state by more than robust_cost_margin; feedback as kTube.
+enum class ControllerVariant { kPlain, kTube, kRobust };
+
+inline const char* variant_name(ControllerVariant v) {
+  return v == ControllerVariant::kTube ? "tube" : v == ControllerVariant::kRobust ? "robust" : "plain";
+}
+// "plain" | "tube" | "robust"; false for anything else.
+inline bool parse_controller_variant(const std::string& name, ControllerVariant* v) {
+  if (name == "plain") *v = ControllerVariant::kPlain;
+  else if (name == "tube") *v = ControllerVariant::kTube;
+  else if (name == "robust") *v = ControllerVariant::kRobust;
+  else return false;
+  return true;
+}
 
 struct ControllerOptions {
   int num_samples = 1920;          // K: sampled control sequences per iteration
@@ -43,6 +67,12 @@ struct ControllerOptions {
   // every iteration so that the effective sample size is ess_share * K (within the tolerance
   // and the bounds); `lambda` above is then only the first step's starting guess.
   TemperatureTarget temperature;
+  // The variant and its ancillary feedback (see ControllerVariant; mppi/ancillary.hpp).
+  ControllerVariant variant = ControllerVariant::kPlain;
+  AncillaryWeights ancillary;            // the LQR's Q, R along the plan
+  float tube_reset_distance = 2.0f;      // sqrt((x - x_nom)' Q (x - x_nom)) that resets the nominal state
+  float robust_cost_margin = 0.0f;       // kRobust: cost the measured state may add [cost units]
+
   // Actuator-aware planning (mppi/actuator_chain.hpp): the delay, rate limit and lag between
   // each channel's command and the model's input; empty = the model takes the command directly.
   std::vector<ActuatorChannel> actuators;
@@ -91,6 +121,14 @@ struct ControllerOptions {
         return fail("temperature.tolerance must be in (0, 1)");
     }
     if (!actuators_are_valid(actuators, num_controls, dt_s, why)) return false;
+    if (variant != ControllerVariant::kPlain) {
+      if (!actuators.empty())
+        return fail("the tube and robust variants plan without an actuator chain (actuators must be empty)");
+      if (!(tube_reset_distance > 0.f) || !std::isfinite(tube_reset_distance))
+        return fail("tube_reset_distance must be > 0 and finite");
+      if (!(robust_cost_margin >= 0.f) || !std::isfinite(robust_cost_margin))
+        return fail("robust_cost_margin must be >= 0 and finite");
+    }
     return true;
   }
 };

@@ -323,6 +323,7 @@ class CpuBackend final : public Backend {
     totals_.assign(static_cast<std::size_t>(chunks), detail::ChunkTotals{});
     sums_.assign(rows, 0.0);
     scales_.assign(static_cast<std::size_t>(chunks), 0.0);
+    plan_lanes_ = aligned_floats(rows * kChunk);
   }
 
   const char* name() const override { return "cpu"; }
@@ -484,6 +485,23 @@ class CpuBackend final : public Backend {
   // ---- the ancillary feedback: the model linearised along the plan (mppi/linearize.hpp) and
   // the time-varying LQR on it (mppi/lqr.hpp)
  public:
+  bool supports_feedback() const override { return true; }
+  // One chunk rolled out with the plan in every lane (lane 0's cost is taken): a thirtieth of
+  // an iteration at K = 1920. Uses the first thread's work slice (iterate() is not running).
+  bool plan_cost(std::span<const float> x0, std::span<const float> plan, float* cost, std::string* why) override {
+    const std::size_t rows = static_cast<std::size_t>(shape_.horizon) * D::kNu;
+    if (x0.size() != static_cast<std::size_t>(D::kNx) || plan.size() != rows) {
+      if (why) *why = "cpu backend: plan_cost needs x0 of num_states and a T x nu plan";
+      return false;
+    }
+    for (std::size_t r = 0; r < rows; ++r) std::fill_n(plan_lanes_.get() + r * kChunk, kChunk, plan[r]);
+    alignas(64) float lane_costs[kChunk];
+    detail::rollout_chunk(model_, cost_, x0.data(), plan_lanes_.get(), kChunk, shape_.horizon, dt_s_, 0,
+                          work_.data(), lane_costs);
+    *cost = lane_costs[0];
+    return true;
+  }
+
   bool ancillary_gains(std::span<const float> x0, std::span<const float> nominal,
                        const AncillaryWeights& w, std::span<float> states_out,
                        std::span<float> gains_out, std::string* why) override {
@@ -545,6 +563,7 @@ class CpuBackend final : public Backend {
     LqrWorkspace lqr;
   };
   AncillaryWork ancillary_;
+  AlignedFloats plan_lanes_;  // plan_cost(): the plan in every lane (T x nu x kChunk)
 };
 
 }  // namespace mppi

@@ -327,6 +327,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
     optimizer_ms.push_back(step_summary.optimizer_ms);
     ess.push_back(step_summary.effective_sample_size);
     lambdas.push_back(step_summary.lambda);
+    summary.nominal_resets += step_summary.nominal_reset ? 1 : 0;
     for (int i = 0; i < substeps; ++i) {
       plant.advance(command, static_cast<float>(config.plant_dt_s));
       t += config.plant_dt_s;
@@ -423,6 +424,8 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   summary.ess_target_share = config.controller.temperature.ess_share;
   summary.lambda_p50 = percentile(lambdas, 50);
   summary.actuator_model = config.actuator_model.empty() ? "none" : config.actuator_model;
+  if (summary.actuator_model == "none" && !config.controller.actuators.empty()) summary.actuator_model = "custom";
+  summary.variant = variant_name(config.controller.variant);
   if (summary.ess_target_share > 0 && !ess.empty()) {
     const double want = summary.ess_target_share * config.controller.num_samples;
     std::size_t in_band = 0;

@@ -52,6 +52,8 @@ std::string to_json(const RunSummary& s) {
   j["ess_in_band_share"] = number(s.ess_in_band_share);
   j["lambda_p50"] = number(s.lambda_p50);
   j["actuator_model"] = s.actuator_model;
+  j["variant"] = s.variant;
+  j["nominal_resets"] = s.nominal_resets;
   j["backend"] = s.backend;
   j["failed_steps"] = s.failed_steps;
   j["backend_switches"] = nlohmann::ordered_json::array();

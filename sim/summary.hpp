@@ -55,6 +55,10 @@ struct RunSummary {
   double ess_in_band_share = std::numeric_limits<double>::quiet_NaN();
   double lambda_p50 = 0.0;
   std::string actuator_model = "none";
+  // The variant (plain | tube | robust) and, for tube / robust, the steps whose nominal state
+  // was put back on the measured one.
+  std::string variant = "plain";
+  int nominal_resets = 0;
   std::string backend;                // the backend the run started on ("cpu", "vulkan")
   int failed_steps = 0;               // control steps that returned the safe control
   std::vector<BackendSwitchRecord> backend_switches;

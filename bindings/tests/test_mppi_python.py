@@ -239,3 +239,29 @@ def test_controller_variants_from_python():
     o.actuators = [mppi.ActuatorChannel(delay_s=-1.0), mppi.ActuatorChannel()]
     with pytest.raises(mppi.Error, match="delay_s"):
         mppi.Controller("single-track", cost, o)
+
+
+def test_tube_variant_publishes_its_gains():
+    """The tube variant's gains and nominal states reach Python with their shapes; the control
+    sent is the plan's first control plus the first gain times the state error."""
+    cmap = mppi.CostMap.load_npz(os.path.join(DATA, "autorally/maps/gazebo/gazebo_costmap.npz"))
+    cost = mppi.AutoRallyCost(cmap)
+    o = mppi.ControllerOptions()
+    o.num_samples = 256
+    o.num_threads = 1
+    o.variant = "tube"
+    o.tube_reset_distance = 5.0
+    c = mppi.Controller("kinematic", cost, o)
+    x = c.model_state(mppi.VehicleState(x_m=-8.5, y_m=-8.9, yaw_rad=2.356, vx_mps=5.0))
+    u, s = c.step(x)
+    assert s.feedback_applied and s.nominal_reset
+    assert c.feedback_gains.shape == (100, 2, c.num_states)
+    assert c.nominal_states.shape == (101, c.num_states)
+    x_nom = c.nominal_states[1].copy()  # where the nominal state went
+    x_meas = x_nom.copy()
+    x_meas[0] += 0.1  # 10 cm off in x
+    u, s = c.step(x_meas)
+    assert not s.nominal_reset
+    assert s.tube_distance == pytest.approx(0.1, rel=1e-3)
+    with pytest.raises(mppi.Error, match="plain, tube or robust"):
+        o.variant = "rmppi"

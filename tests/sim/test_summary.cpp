@@ -64,8 +64,12 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.ess_target_share = 0.125;
   s.lambda_p50 = 3.5;
   s.actuator_model = "plant";
+  s.variant = "tube";
+  s.nominal_resets = 7;
   const auto j = nlohmann::json::parse(to_json(s));
-  CHECK(j.size() == 33);
+  CHECK(j.size() == 35);
+  CHECK(j.at("variant") == "tube");
+  CHECK(j.at("nominal_resets") == 7);
   CHECK(j.at("sampler") == "smooth");
   CHECK(j.at("ess_target_share") == 0.125);
   CHECK(j.at("ess_in_band_share").is_null());  // NaN: a fixed temperature
