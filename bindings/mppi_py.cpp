@@ -170,6 +170,7 @@ PYBIND11_MODULE(mppi, m) {
       .def_readwrite("horizon", &mppi::ControllerOptions::horizon)
       .def_readwrite("dt_s", &mppi::ControllerOptions::dt_s)
       .def_readwrite("iterations", &mppi::ControllerOptions::iterations)
+      .def_readwrite("warm_start_iterations", &mppi::ControllerOptions::warm_start_iterations)
       .def_readwrite("lambda_", &mppi::ControllerOptions::lambda, "temperature (lambda)")
       .def_readwrite("gamma", &mppi::ControllerOptions::gamma)
       .def_readwrite("noise_std", &mppi::ControllerOptions::noise_std)

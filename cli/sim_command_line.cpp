@@ -1,6 +1,8 @@
 #include "cli/sim_command_line.hpp"
 
+#include <algorithm>
 #include <string>
+#include <vector>
 
 #include "cli/app.hpp"
 #include "cli/options.hpp"
@@ -13,6 +15,42 @@ namespace {
 CLI::Option* add_float_option(CLI::App& app, const std::string& name, float& target, const std::string& description) {
   return app.add_option_function<double>(name, [&target](double v) { target = static_cast<float>(v); }, description)
       ->default_str(CLI::detail::to_string(target));
+}
+
+// A comma-separated list of numbers ("" = empty), so that an empty default round-trips
+// through a run file.
+CLI::Option* add_float_list_option(CLI::App& app, const std::string& name, std::vector<float>& target,
+                                   const std::string& description) {
+  auto join = [](const std::vector<float>& v) {
+    std::string text;
+    for (std::size_t i = 0; i < v.size(); ++i) text += (i ? "," : "") + CLI::detail::to_string(v[i]);
+    return text;
+  };
+  return app
+      .add_option_function<std::string>(
+          name,
+          [&target, name](const std::string& text) {
+            std::vector<float> values;
+            std::size_t start = 0;
+            while (start < text.size()) {
+              const std::size_t end = std::min(text.find(',', start), text.size());
+              const std::string item = text.substr(start, end - start);
+              std::size_t used = 0;
+              double v = 0.0;
+              try {
+                v = std::stod(item, &used);
+              } catch (const std::exception&) {
+                used = 0;
+              }
+              if (used == 0 || used != item.size())
+                throw CLI::ValidationError(name, "'" + item + "' is not a number (give numbers separated by commas)");
+              values.push_back(static_cast<float>(v));
+              start = end + 1;
+            }
+            target = std::move(values);
+          },
+          description)
+      ->default_str(join(target));
 }
 
 }  // namespace
@@ -64,6 +102,10 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
   app.add_option("--samples", mppi.num_samples, "MPPI samples per step")->type_name("K");
   app.add_option("--horizon", mppi.horizon, "MPPI time steps")->type_name("T");
   app.add_option("--iterations", mppi.iterations, "MPPI iterations per step")->type_name("N");
+  app.add_option("--warm-start-iterations", mppi.warm_start_iterations,
+                 "extra MPPI iterations at the first step and after each respawn, when the plan is cold")
+      ->type_name("N")
+      ->check(CLI::Range(0, 1000));
   add_float_option(app, "--lambda", mppi.lambda, "MPPI temperature")->type_name("L");
   app.add_option("--smoothing", mppi.smoothing_window, "Savitzky-Golay window over the plan (odd, <= the horizon; upstream AutoRally: 5), 0 = off")
       ->type_name("W");
@@ -110,14 +152,14 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
                    "for the measured state to be taken [cost units]")
       ->type_name("C")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--ancillary-q", mppi.ancillary.q_diag,
-                 "tube / robust: the feedback's state weights, one per model state (default: 1 each)")
-      ->type_name("Q,...")
-      ->delimiter(',');
-  app.add_option("--ancillary-r", mppi.ancillary.r_diag,
-                 "tube / robust: the feedback's control weights, one per control (default: 1 each)")
-      ->type_name("R,...")
-      ->delimiter(',');
+  add_float_list_option(app, "--ancillary-q", mppi.ancillary.q_diag,
+                        "tube / robust: the feedback's state weights, comma-separated, one per model state "
+                        "(empty: 1 each)")
+      ->type_name("Q,...");
+  add_float_list_option(app, "--ancillary-r", mppi.ancillary.r_diag,
+                        "tube / robust: the feedback's control weights, comma-separated, one per control "
+                        "(empty: 1 each)")
+      ->type_name("R,...");
   app.add_option("--actuator-model", c.actuator_model,
                  "the actuators the controller plans through (delay, rate limit, lag per channel): none | plant "
                  "(the simulated car's own) | a corrected-model FILE (mppi-fit diagnose)")

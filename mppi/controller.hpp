@@ -177,8 +177,13 @@ class Controller {
     std::copy(x0.begin(), x0.end(), x0_.begin());
     if (feedback()) choose_nominal_state(sum);
     try {
-      for (int it = 0; it < options_.iterations; ++it) {
-        const auto iteration = static_cast<std::uint32_t>(step_index_ * options_.iterations + it);
+      // A cold plan (first step after construction or reset) gets the warm-start iterations
+      // first, with noise counters of their own (the top half of the counter space).
+      const int warm = cold_plan_ ? options_.warm_start_iterations : 0;
+      for (int it = 0; it < warm + options_.iterations; ++it) {
+        const auto iteration =
+            it < warm ? static_cast<std::uint32_t>(0x80000000u + (warm_starts_ * warm + static_cast<std::uint64_t>(it)) % 0x80000000u)
+                      : static_cast<std::uint32_t>(step_index_ * options_.iterations + (it - warm));
         if (backend_->has_iterate()) {
           if (!device_iteration(iteration, sum)) return safe_output(sum, start);
         } else {
@@ -203,6 +208,8 @@ class Controller {
       }
     }
     if (feedback()) apply_feedback(sum);
+    if (cold_plan_ && options_.warm_start_iterations > 0) ++warm_starts_;
+    cold_plan_ = false;
     sent(output_);
     shift_nominal();
     ++step_index_;
@@ -515,6 +522,7 @@ class Controller {
   }
 
   void reset_plan() {
+    cold_plan_ = true;
     for (int t = 0; t < options_.horizon; ++t)
       for (int c = 0; c < nu_; ++c)
         nominal_[t * nu_ + c] = std::clamp(0.f, options_.control_min[c], options_.control_max[c]);
@@ -608,6 +616,8 @@ class Controller {
   // tube / robust variants
   std::vector<float> nominal_state_;   // nx: the state the next step plans from
   bool have_nominal_state_ = false;    // false: the next step starts it at the measured state
+  bool cold_plan_ = true;              // the plan is reset_plan()'s zeros: warm-start iterations due
+  std::uint64_t warm_starts_ = 0;      // warm starts run (their noise counters follow on)
   std::vector<float> measured_;        // nx: this step's measured state
   std::vector<float> nominal_states_;  // (T + 1) x nx along the last plan
   std::vector<float> gains_;           // T x nu x nx

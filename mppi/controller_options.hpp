@@ -48,6 +48,9 @@ struct ControllerOptions {
   int horizon = 100;               // T: time steps per sequence
   float dt_s = 0.02f;              // model time step [s] (AutoRally: 1/50 Hz)
   int iterations = 1;              // optimisation iterations per control step
+  // Extra iterations at the first step after construction or reset(), when the plan is cold
+  // (all zeros): the plan converges before the first command goes out. 0 = none.
+  int warm_start_iterations = 0;
   float lambda = 6.0f;             // temperature of the exponential weights [cost units]
   float gamma = 0.0f;              // weight of the control cost gamma * sum_t u^T Sigma^-1 eps
   std::vector<float> noise_std = {0.275f, 0.3f};    // per control channel (diagonal Sigma)
@@ -87,6 +90,8 @@ struct ControllerOptions {
     if (horizon < 1) return fail("horizon must be >= 1, got " + std::to_string(horizon));
     if (!(dt_s > 0.f) || !std::isfinite(dt_s)) return fail("dt_s must be > 0");
     if (iterations < 1) return fail("iterations must be >= 1");
+    if (warm_start_iterations < 0 || warm_start_iterations > 1000)
+      return fail("warm_start_iterations must be in [0, 1000]");
     if (!(lambda > 0.f) || !std::isfinite(lambda)) return fail("lambda must be > 0 and finite");
     if (!(gamma >= 0.f) || !std::isfinite(gamma)) return fail("gamma must be >= 0 and finite");
     const auto n = static_cast<std::size_t>(num_controls);

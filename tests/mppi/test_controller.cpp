@@ -230,3 +230,30 @@ TEST_CASE("invalid options are rejected with a reason", "[core][mppi]") {
   CHECK_THROWS_WITH(mppi::make_cpu_controller(DoubleIntegrator{}, QuadraticCost{}, options),
                     Catch::Contains("smoothing_window"));
 }
+
+TEST_CASE("warm-start iterations converge a cold plan at the first step after a reset", "[core][mppi]") {
+  // One iteration per step, 60 more when the plan is cold: the first control is the LQR
+  // optimum as with 60 iterations every step; the next step runs one; reset() makes it cold again.
+  const QuadraticCost cost;
+  auto options = linear_options();
+  options.iterations = 1;
+  options.warm_start_iterations = 60;
+  auto controller = mppi::make_cpu_controller(DoubleIntegrator{}, cost, options);
+  const float x0[2] = {1.0f, 0.0f};
+  const Eigen::VectorXd u_star =
+      lqr_open_loop(Eigen::Vector2d(1.0, 0.0), options.horizon, options.dt_s, cost.qp, cost.qv, cost.r);
+  mppi::StepSummary summary;
+  float u0 = controller.step(x0, &summary)[0];
+  CHECK(summary.iterations == 61);
+  CHECK(u0 == Approx(u_star(0)).epsilon(0.03));
+  controller.step(x0, &summary);
+  CHECK(summary.iterations == 1);
+  controller.reset();
+  u0 = controller.step(x0, &summary)[0];
+  CHECK(summary.iterations == 61);
+  CHECK(u0 == Approx(u_star(0)).epsilon(0.03));
+  // Without them, one iteration from a cold plan is far from the optimum.
+  options.warm_start_iterations = 0;
+  auto cold = mppi::make_cpu_controller(DoubleIntegrator{}, cost, options);
+  CHECK(std::abs(cold.step(x0, &summary)[0] - u_star(0)) > 0.1 * std::abs(u_star(0)));
+}
