@@ -400,6 +400,8 @@ PYBIND11_MODULE(mppi, m) {
       .def_readonly("optimizer_ms_p50", &Sum::optimizer_ms_p50)
       .def_readonly("optimizer_ms_p99", &Sum::optimizer_ms_p99)
       .def_readonly("effective_sample_size_mean", &Sum::effective_sample_size_mean)
+      .def_readonly("mean_abs_steer_step", &Sum::mean_abs_steer_step)
+      .def_readonly("mean_abs_throttle_step", &Sum::mean_abs_throttle_step)
       .def("to_json", [](const Sum& s) { return mppi::sim::to_json(s); });
 
   m.def("run_closed_loop", [](const Cfg& config) {

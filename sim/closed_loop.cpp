@@ -188,7 +188,7 @@ double vehicle_limit_lap_s(const ClosedLoopConfig& config, const SingleTrackPara
 template <class P>
 double plant_limit_lap_s(const ClosedLoopConfig& config, const P& plant, const Track& track) {
   const std::optional<SingleTrackParams> vehicle =
-      config.plant == kCorrectedModel && config.surface_yaml.empty()
+      config.plant == kCorrectedModel
           ? corrected_limit_lap_vehicle(load_corrected_model(config.plant_params_yaml))
           : limit_lap_vehicle(plant);
   return vehicle ? vehicle_limit_lap_s(config, *vehicle, track) : std::numeric_limits<double>::quiet_NaN();

@@ -95,9 +95,8 @@ TEST_CASE("robustness plants: the default single-track car with exactly one effe
 
 TEST_CASE("robustness plants: grip x 0.7 scales the whole friction curve, its peak included", "[sim][robustness]") {
   const CorrectedModelFile file = robustness_plant("grip");
-  // The plant's tyres after the grip change (WithEffects::with_core; the change is at t = 0).
-  const SingleTrackParams low = CorrectedSingleTrack::with_core(SingleTrack(file.nominal), file.effects,
-                                                                file.effects.grip_scale).params();
+  // The tyres after the grip change, as WithEffects builds them (the change is at t = 0).
+  const SingleTrackParams low = apply_effect_params(file.nominal, file.effects, file.effects.grip_scale);
   const auto nominal = PacejkaCoeffs<double>::from(file.nominal.tyre);
   const auto scaled = PacejkaCoeffs<double>::from(low.tyre);
   double peak_nominal = 0.0, peak_scaled = 0.0;
@@ -108,6 +107,24 @@ TEST_CASE("robustness plants: grip x 0.7 scales the whole friction curve, its pe
     peak_scaled = std::max(peak_scaled, std::abs(mu_low));
   }
   CHECK(peak_scaled == Approx(0.7 * peak_nominal).epsilon(1e-9));
+}
+
+TEST_CASE("robustness plants: a car sliding sideways is stopped by 0.7x the nominal force", "[sim][robustness]") {
+  // At 5 m/s with 1 m/s of sideways slide and no yaw rate, both axles slide: the lateral
+  // deceleration over the first 2 ms is the friction force over the mass.
+  auto lateral_decel_mps2 = [](const CorrectedModelFile& file) {
+    sim::Plant<CorrectedSingleTrack> plant = plant_of(file);
+    VehicleState s;
+    s.vx_mps = 5.f;
+    s.vy_mps = 1.f;
+    plant.reset(s);
+    plant.advance({0.f, 0.f}, 0.002f);
+    return (1.0 - plant.vehicle_state().vy_mps) / 0.002;
+  };
+  const double nominal = lateral_decel_mps2(no_mismatch()), low = lateral_decel_mps2(robustness_plant("grip"));
+  INFO("lateral deceleration: nominal " << nominal << " m/s^2, grip " << low << " m/s^2");
+  CHECK(nominal > 1.0);
+  CHECK(low / nominal == Approx(0.7).margin(0.02));
 }
 
 TEST_CASE("robustness plants: the delay holds both commands back 0.08 s", "[sim][robustness]") {

@@ -60,8 +60,10 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.peak_slip_angle_rad = 0.25;
   s.p95_slip_angle_rad = 0.125;
   s.peak_lateral_accel_mps2 = 6.5;
+  s.mean_abs_steer_step = 0.0625;
+  s.mean_abs_throttle_step = 0.03125;
   const auto j = nlohmann::json::parse(to_json(s));
-  CHECK(j.size() == 28);
+  CHECK(j.size() == 30);
   CHECK(j.at("track") == "gazebo");
   CHECK(j.at("model") == "nn_autorally");
   CHECK(j.at("plant") == "single_track");
@@ -83,6 +85,8 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   CHECK(j.at("max_speed_mps") == 7.25);
   CHECK(j.at("optimizer_ms_p50") == 1.5);
   CHECK(j.at("optimizer_ms_p99").is_null());
+  CHECK(j.at("mean_abs_steer_step") == 0.0625);
+  CHECK(j.at("mean_abs_throttle_step") == 0.03125);
   CHECK(j.at("effective_sample_size_mean") == 42.5);
   CHECK(j.at("peak_slip_angle_rad") == 0.25);
   CHECK(j.at("p95_slip_angle_rad") == 0.125);
