@@ -482,6 +482,8 @@ PYBIND11_MODULE(mppi, m) {
       .def_readonly("actuator_model", &Sum::actuator_model)
       .def_readonly("variant", &Sum::variant)
       .def_readonly("nominal_resets", &Sum::nominal_resets)
+      .def_readonly("mean_abs_steer_step", &Sum::mean_abs_steer_step)
+      .def_readonly("mean_abs_throttle_step", &Sum::mean_abs_throttle_step)
       .def("to_json", [](const Sum& s) { return mppi::sim::to_json(s); });
 
   m.def("run_closed_loop", [](const Cfg& config) {

@@ -25,6 +25,8 @@
 #include "mppi/controller.hpp"
 #include "base/error.hpp"
 #include "factory/make_controller.hpp"
+#include "sim/command_steps.hpp"
+#include "sim/corrected_limit_vehicle.hpp"
 #include "sim/crash_detector.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/geometry.hpp"
@@ -182,10 +184,14 @@ double vehicle_limit_lap_s(const ClosedLoopConfig& config, const SingleTrackPara
   }
 }
 
-// The same for the plant's vehicle (limit_lap_vehicle); NaN where the plant has none.
+// The same for the plant's vehicle (limit_lap_vehicle; a corrected-model plant's from its file,
+// corrected_limit_lap_vehicle); NaN where the plant has none.
 template <class P>
 double plant_limit_lap_s(const ClosedLoopConfig& config, const P& plant, const Track& track) {
-  const std::optional<SingleTrackParams> vehicle = limit_lap_vehicle(plant);
+  const std::optional<SingleTrackParams> vehicle =
+      config.plant == kCorrectedModel
+          ? corrected_limit_lap_vehicle(load_corrected_model(config.plant_params_yaml))
+          : limit_lap_vehicle(plant);
   return vehicle ? vehicle_limit_lap_s(config, *vehicle, track) : std::numeric_limits<double>::quiet_NaN();
 }
 
@@ -262,6 +268,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   std::vector<std::pair<float, float>> crash_points;
   double speed_sum = 0.0;
   long speed_samples = 0;
+  CommandSteps command_steps;
   bool in_contact = false;
   double t = 0.0;
   int reported_laps = 0;
@@ -324,6 +331,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
     // widths and back through the simulated servos); through_chassis = false bypasses it.
     const Control output{u[control::kSteer], u[control::kThrottle]};
     const Control command = chassis ? chassis->drive(output, t) : output;
+    command_steps.add(command);
     optimizer_ms.push_back(step_summary.optimizer_ms);
     ess.push_back(step_summary.effective_sample_size);
     lambdas.push_back(step_summary.lambda);
@@ -414,6 +422,8 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
     for (double lap_time : summary.lap_times_s) summary.lap_time_ratio.push_back(lap_time / limit_lap_s);
   summary.finished = summary.laps_completed >= config.laps;
   summary.mean_speed_mps = speed_samples ? speed_sum / speed_samples : 0.0;
+  summary.mean_abs_steer_step = command_steps.mean_abs_steer_step();
+  summary.mean_abs_throttle_step = command_steps.mean_abs_throttle_step();
   summary.optimizer_ms_p50 = percentile(optimizer_ms, 50);
   summary.p95_slip_angle_rad = abs_slip.empty() ? 0.0 : percentile(abs_slip, 95);
   summary.optimizer_ms_p99 = percentile(optimizer_ms, 99);
@@ -454,7 +464,10 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
 std::optional<SingleTrackParams> plant_vehicle_params(const ClosedLoopConfig& config) {
   if (!config.surface_yaml.empty())  // the single-track plant on a surface map: its own car file
     return load_single_track_params(model_file<models::SingleTrackModel>(config.plant_params_yaml, config.network_npz));
-  if (config.plant == kCorrectedModel) return std::nullopt;
+  if (config.plant == kCorrectedModel)
+    return config.plant_params_yaml.empty()
+               ? std::nullopt
+               : corrected_limit_lap_vehicle(load_corrected_model(config.plant_params_yaml));
   return with_model(config.plant, [&]<class D>() -> std::optional<SingleTrackParams> {
     if constexpr (HasSingleTrackCore<typename D::Model>)
       return limit_lap_vehicle(D::load(model_file<D>(config.plant_params_yaml, config.network_npz)));

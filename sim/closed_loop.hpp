@@ -79,9 +79,10 @@ RunSummary run_closed_loop(const ClosedLoopConfig& config);
 
 // The single-track parameters of the config's plant, whose limit lap its laps are measured
 // against: the single-track plant's file; the double-track's base; the full vehicle's base with
-// its drag as aero_drag_kgpm (FullVehicleParams::rigid_limit). None for the other plants (the
-// network, the kinematic bicycle, corrected-model files). Throws mppi::Error for an unknown
-// plant or a bad data file.
+// its drag as aero_drag_kgpm (FullVehicleParams::rigid_limit); a corrected-model file with the
+// single-track nominal: that car with its payload and grip (sim/corrected_limit_vehicle.hpp says
+// which effects count). None for the other plants (the network, the kinematic bicycle, other
+// corrected-model files). Throws mppi::Error for an unknown plant or a bad data file.
 std::optional<SingleTrackParams> plant_vehicle_params(const ClosedLoopConfig& config);
 
 }  // namespace mppi::sim

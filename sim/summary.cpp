@@ -44,6 +44,8 @@ std::string to_json(const RunSummary& s) {
   j["peak_slip_angle_rad"] = number(s.peak_slip_angle_rad);
   j["p95_slip_angle_rad"] = number(s.p95_slip_angle_rad);
   j["peak_lateral_accel_mps2"] = number(s.peak_lateral_accel_mps2);
+  j["mean_abs_steer_step"] = number(s.mean_abs_steer_step);
+  j["mean_abs_throttle_step"] = number(s.mean_abs_throttle_step);
   j["optimizer_ms_p50"] = number(s.optimizer_ms_p50);
   j["optimizer_ms_p99"] = number(s.optimizer_ms_p99);
   j["effective_sample_size_mean"] = number(s.effective_sample_size_mean);

@@ -44,6 +44,10 @@ struct RunSummary {
   double peak_slip_angle_rad = 0.0;   // max |slip|
   double p95_slip_angle_rad = 0.0;    // 95th percentile of |slip|
   double peak_lateral_accel_mps2 = 0.0;
+  // Mean |u_k - u_{k-1}| of the commands sent to the car (log.csv's steer and throttle) over
+  // consecutive control steps (sim/command_steps.hpp): how much the controller chatters.
+  double mean_abs_steer_step = 0.0;
+  double mean_abs_throttle_step = 0.0;
   double optimizer_ms_p50 = 0.0;      // wall time of one controller step, median
   double optimizer_ms_p99 = 0.0;
   double effective_sample_size_mean = 0.0;

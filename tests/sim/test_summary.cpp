@@ -66,8 +66,10 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.actuator_model = "plant";
   s.variant = "tube";
   s.nominal_resets = 7;
+  s.mean_abs_steer_step = 0.0625;
+  s.mean_abs_throttle_step = 0.03125;
   const auto j = nlohmann::json::parse(to_json(s));
-  CHECK(j.size() == 35);
+  CHECK(j.size() == 37);
   CHECK(j.at("variant") == "tube");
   CHECK(j.at("nominal_resets") == 7);
   CHECK(j.at("sampler") == "smooth");
@@ -96,6 +98,8 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   CHECK(j.at("max_speed_mps") == 7.25);
   CHECK(j.at("optimizer_ms_p50") == 1.5);
   CHECK(j.at("optimizer_ms_p99").is_null());
+  CHECK(j.at("mean_abs_steer_step") == 0.0625);
+  CHECK(j.at("mean_abs_throttle_step") == 0.03125);
   CHECK(j.at("effective_sample_size_mean") == 42.5);
   CHECK(j.at("peak_slip_angle_rad") == 0.25);
   CHECK(j.at("p95_slip_angle_rad") == 0.125);
