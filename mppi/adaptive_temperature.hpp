@@ -20,12 +20,9 @@ struct TemperatureTarget {
   float tolerance = 0.1f;    // accept an ESS within this share of the target
 };
 
-// ESS of the weights at temperature lambda; costs that are not finite weigh 0. 0 if none is.
-inline double effective_sample_size(std::span<const float> costs, double lambda) {
-  float min_cost = std::numeric_limits<float>::infinity();
-  for (float s : costs)
-    if (std::isfinite(s)) min_cost = std::min(min_cost, s);
-  if (!std::isfinite(min_cost)) return 0.0;
+namespace detail {
+// ESS at temperature lambda of the finite costs, whose minimum is min_cost.
+inline double effective_sample_size(std::span<const float> costs, float min_cost, double lambda) {
   const double inv_lambda = 1.0 / lambda;
   double sum = 0.0, sum_sq = 0.0;
   for (float s : costs) {
@@ -36,6 +33,19 @@ inline double effective_sample_size(std::span<const float> costs, double lambda)
   }
   return sum * sum / sum_sq;
 }
+inline float min_finite(std::span<const float> costs) {
+  float m = std::numeric_limits<float>::infinity();
+  for (float s : costs)
+    if (std::isfinite(s)) m = std::min(m, s);
+  return m;
+}
+}  // namespace detail
+
+// ESS of the weights at temperature lambda; costs that are not finite weigh 0. 0 if none is.
+inline double effective_sample_size(std::span<const float> costs, double lambda) {
+  const float min_cost = detail::min_finite(costs);
+  return std::isfinite(min_cost) ? detail::effective_sample_size(costs, min_cost, lambda) : 0.0;
+}
 
 // The temperature in [lambda_min, lambda_max] whose ESS is within tolerance of
 // ess_share * costs.size(), starting from `previous`; the nearer bound when the target lies
@@ -45,8 +55,12 @@ inline float solve_temperature(std::span<const float> costs, const TemperatureTa
   const double want = std::max(1.0, static_cast<double>(target.ess_share) * static_cast<double>(costs.size()));
   const double tol = target.tolerance * want;
   const double lo_bound = target.lambda_min, hi_bound = target.lambda_max;
+  const float min_cost = detail::min_finite(costs);
+  auto effective_sample_size = [&](double l) {
+    return std::isfinite(min_cost) ? detail::effective_sample_size(costs, min_cost, l) : 0.0;
+  };
   double lambda = std::clamp(static_cast<double>(previous), lo_bound, hi_bound);
-  double ess = effective_sample_size(costs, lambda);
+  double ess = effective_sample_size(lambda);
   auto done = [&](double l, double e) {
     if (ess_out) *ess_out = e;
     return static_cast<float>(l);
@@ -58,7 +72,7 @@ inline float solve_temperature(std::span<const float> costs, const TemperatureTa
     while (true) {
       lo = hi;
       hi = std::min(hi * 4.0, hi_bound);
-      const double e = effective_sample_size(costs, hi);
+      const double e = effective_sample_size(hi);
       if (std::abs(e - want) <= tol) return done(hi, e);
       if (e > want) break;
       if (hi >= hi_bound) return done(hi, e);
@@ -67,7 +81,7 @@ inline float solve_temperature(std::span<const float> costs, const TemperatureTa
     while (true) {
       hi = lo;
       lo = std::max(lo / 4.0, lo_bound);
-      const double e = effective_sample_size(costs, lo);
+      const double e = effective_sample_size(lo);
       if (std::abs(e - want) <= tol) return done(lo, e);
       if (e < want) break;
       if (lo <= lo_bound) return done(lo, e);
@@ -77,7 +91,7 @@ inline float solve_temperature(std::span<const float> costs, const TemperatureTa
   double mid = std::sqrt(lo * hi), e = 0.0;
   for (int i = 0; i < 40; ++i) {
     mid = std::sqrt(lo * hi);
-    e = effective_sample_size(costs, mid);
+    e = effective_sample_size(mid);
     if (std::abs(e - want) <= tol) break;
     (e < want ? lo : hi) = mid;
   }

@@ -488,9 +488,8 @@ class Controller {
   void retemper(float min_cost, StepSummary& sum) {
     const auto costs = std::span<const float>(costs_).first(options_.num_samples);
     const float want = options_.temperature.ess_share * static_cast<float>(options_.num_samples);
-    const bool missed = std::abs(sum.effective_sample_size - want) > options_.temperature.tolerance * want;
+    if (std::abs(sum.effective_sample_size - want) <= options_.temperature.tolerance * want) return;  // met: lambda_ stands
     lambda_ = solve_temperature(costs, options_.temperature, lambda_);
-    if (!missed) return;
     const std::span<const float> v = backend_->sampled_controls();
     if (v.size() < next_.size() * static_cast<std::size_t>(padded_)) return;  // keeps none: weights stand
     sum.effective_sample_size = exponential_weights(min_cost, lambda_);

@@ -143,11 +143,8 @@ std::vector<float> sampled_controls(int padded) {
 }
 
 // ---- 1. the full control step ------------------------------------------------------------
-void BM_MppiIteration(benchmark::State& state) {
-  const int threads = static_cast<int>(state.range(0));
-  mppi::AutoRallyNetwork net = network();
-  if (!network_with_precision(state.range(1) != 0, &net)) return state.SkipWithError("no AVX512-BF16");
-  mppi::Controller controller = mppi::make_cpu_controller(net, make_cost(), options(threads));
+// Times controller.step() from the start state (after 3 warm-up steps); the last summary.
+mppi::StepSummary time_steps(benchmark::State& state, mppi::Controller& controller, int threads) {
   const std::vector<float> x0 = model_state(network(), start_state());
   mppi::StepSummary summary;
   for (int i = 0; i < 3; ++i) controller.step(x0, &summary);  // warm caches and thread pool
@@ -157,6 +154,15 @@ void BM_MppiIteration(benchmark::State& state) {
     benchmark::ClobberMemory();
   }
   set_rate_counters(state, threads);
+  return summary;
+}
+
+void BM_MppiIteration(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  mppi::AutoRallyNetwork net = network();
+  if (!network_with_precision(state.range(1) != 0, &net)) return state.SkipWithError("no AVX512-BF16");
+  mppi::Controller controller = mppi::make_cpu_controller(net, make_cost(), options(threads));
+  const mppi::StepSummary summary = time_steps(state, controller, threads);
   state.counters["min_cost"] = summary.min_cost;
   state.counters["ess"] = summary.effective_sample_size;
   state.counters["valid"] = summary.valid_samples;
@@ -177,15 +183,7 @@ void BM_VariantIteration(benchmark::State& state) {
     default: break;
   }
   mppi::Controller controller = mppi::make_cpu_controller(network(), make_cost(), o);
-  const std::vector<float> x0 = model_state(network(), start_state());
-  mppi::StepSummary summary;
-  for (int i = 0; i < 3; ++i) controller.step(x0, &summary);  // warm caches and thread pool
-  for (auto _ : state) {
-    auto u = controller.step(x0, &summary);
-    benchmark::DoNotOptimize(u.data());
-    benchmark::ClobberMemory();
-  }
-  set_rate_counters(state, threads);
+  const mppi::StepSummary summary = time_steps(state, controller, threads);
   state.counters["ess"] = summary.effective_sample_size;
   state.counters["lambda"] = summary.lambda;
   if (summary.status != mppi::StepStatus::kOk) state.SkipWithError(summary.reason);
