@@ -32,8 +32,6 @@ Controller make_controller(D model, C cost, const ControllerOptions& options, Ba
     const char* asked = choice == BackendChoice::kAuto ? "auto" : "asked for Vulkan, falling back";
     if constexpr (!std::is_same_v<C, AutoRallyCost>) {
       r.reason = "this model/cost has no GPU twin (GPU backends run the AutoRally cost)";
-    } else if (!options.actuators.empty()) {
-      r.reason = "actuator-aware planning runs on the CPU backend only";
     } else {
       const auto twin = gpu_twin_of(model, &why);
       if (!twin) {

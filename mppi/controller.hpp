@@ -149,7 +149,7 @@ class Controller {
     if (!options_.actuators.empty()) {
       if (!backend_->supports_actuators())
         throw Error(std::string("ControllerOptions: actuator-aware planning needs a backend that rolls out "
-                                "through the actuators (the CPU backend); the ") +
+                                "through the actuators (the CPU or the Vulkan backend); the ") +
                     backend_->name() + " backend does not");
       for (const ActuatorChannel& c : options_.actuators) actuator_steps_.push_back(actuator_step(c, options_.dt_s));
     }

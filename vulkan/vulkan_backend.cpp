@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -40,13 +41,37 @@ struct StepUbo {
   float control_max[4];
   float x0[kMaxStates];
   float noise_filter[4];   // carry, first gain, gain, white (1) or not (0)
+  float actuator_delay[4];       // delay steps per channel; [3] = 1 when the chain is on
+  float actuator_alpha[4];       // lag factor per channel
+  float actuator_max_change[4];  // rate limit per control step (FLT_MAX: none)
+  float actuator_start[4];       // rate outputs (0, 1), lag outputs (2, 3) at t = 0
+  float actuator_pending[kNu * kMaxActuatorDelaySteps];  // channel c, step t at c * 32 + t
 };
 // The std140 offsets of StepBlock: uvec4/vec4 members at 16-byte steps, x0 as vec4[4].
 static_assert(offsetof(StepUbo, seed) == 16 && offsetof(StepUbo, scalars) == 32 &&
               offsetof(StepUbo, noise_std) == 48 && offsetof(StepUbo, control_min) == 64 &&
               offsetof(StepUbo, control_max) == 80 && offsetof(StepUbo, x0) == 96 &&
               offsetof(StepUbo, noise_filter) == 96 + 4 * kMaxStates &&
-              sizeof(StepUbo) == 112 + 4 * kMaxStates, "StepUbo must mirror StepBlock (std140)");
+              offsetof(StepUbo, actuator_delay) == 112 + 4 * kMaxStates &&
+              offsetof(StepUbo, actuator_pending) == 176 + 4 * kMaxStates &&
+              sizeof(StepUbo) == 176 + 4 * kMaxStates + 4 * kNu * kMaxActuatorDelaySteps,
+              "StepUbo must mirror StepBlock (std140)");
+static_assert(kNu * kMaxActuatorDelaySteps == 64, "StepBlock holds vec4 actuator_pending[16]");
+
+// The actuator chain of one iteration into the step block (off when the plan has none).
+void write_actuators(const ActuatorPlan& plan, StepUbo& s) {
+  s.actuator_delay[3] = plan.enabled() ? 1.f : 0.f;
+  if (!plan.enabled()) return;
+  for (int c = 0; c < kNu; ++c) {
+    const ActuatorStep& a = plan.steps[c];
+    s.actuator_delay[c] = static_cast<float>(a.delay_steps);
+    s.actuator_alpha[c] = a.lag_alpha;
+    s.actuator_max_change[c] = std::min(a.max_change, std::numeric_limits<float>::max());
+    s.actuator_start[c] = plan.start->rate_out[c];
+    s.actuator_start[2 + c] = plan.start->lag_out[c];
+    std::copy_n(plan.start->pending[c], kMaxActuatorDelaySteps, s.actuator_pending + c * kMaxActuatorDelaySteps);
+  }
+}
 
 void check(VkResult r, const char* what) {
   if (r != VK_SUCCESS)
@@ -438,6 +463,7 @@ VulkanBackend::VulkanBackend(const TwinModel& model, const AutoRallyCost& cost, 
   }
   s.scalars[2] = 1.f;
   s.noise_filter[3] = 1.f;
+  write_actuators(ActuatorPlan{}, s);
   m.submit(m.cmd_iterate);
   m.submit(m.cmd_rollout);
 }
@@ -448,6 +474,7 @@ void VulkanBackend::rollout(std::span<const float> x0, std::span<const float> co
                             std::span<float> costs) {
   Impl& m = *impl_;
   m.write_step(x0, 0);
+  write_actuators(ActuatorPlan{}, m.step_ubo());  // rollout() steps the model on the controls given
   const std::size_t n = std::min<std::size_t>(controls.size(), m.buffers[Impl::kControls].bytes / sizeof(float));
   std::copy_n(controls.begin(), n, m.buffers[Impl::kControls].f());
   m.submit(m.cmd_rollout);
@@ -466,6 +493,7 @@ void VulkanBackend::iterate(const IterationInput& in, IterationOutput& out) {
   s.noise_filter[1] = in.noise_filter.first_gain;
   s.noise_filter[2] = in.noise_filter.gain;
   s.noise_filter[3] = in.noise_filter.white() ? 1.f : 0.f;
+  write_actuators(in.actuators, s);
   for (int c = 0; c < kNu; ++c) {
     s.noise_std[c] = in.noise_std[c];
     s.control_min[c] = in.control_min[c];

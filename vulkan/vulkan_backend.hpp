@@ -74,6 +74,7 @@ class VulkanBackend final : public Backend {
   void rollout(std::span<const float> x0, std::span<const float> controls,
                std::span<float> costs) override;
   bool has_iterate() const override { return true; }
+  bool supports_actuators() const override { return true; }
   void iterate(const IterationInput& in, IterationOutput& out) override;
   std::span<const float> sampled_controls() const override;
   bool set_cost_param(std::string_view key, double value, std::string* why) override;

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "costs/autorally_cost.hpp"
@@ -34,8 +35,10 @@ const mppi::AutoRallyCost& gazebo_cost() {
   return cost;
 }
 
-mppi::ControllerOptions parity_options(int k, int t, mppi::SamplerKind sampler) {
+mppi::ControllerOptions parity_options(int k, int t, mppi::SamplerKind sampler,
+                                       std::vector<mppi::ActuatorChannel> actuators = {}) {
   mppi::ControllerOptions o;
+  o.actuators = std::move(actuators);
   o.sampler.kind = sampler;
   o.num_samples = k;
   o.horizon = t;
@@ -74,8 +77,9 @@ struct Worst {
 // 99th percentile: at most 1% of the samples may differ by more than 1e-3.
 template <class D>
 Worst compare(const D& model, int device, int k, int t,
-              mppi::SamplerKind sampler = mppi::SamplerKind::kGaussian) {
-  const mppi::ControllerOptions o = parity_options(k, t, sampler);
+              mppi::SamplerKind sampler = mppi::SamplerKind::kGaussian,
+              std::vector<mppi::ActuatorChannel> actuators = {}, int steps = 2) {
+  const mppi::ControllerOptions o = parity_options(k, t, sampler, std::move(actuators));
   mppi::Controller cpu = mppi::make_cpu_controller(model, gazebo_cost(), o);
   std::string why;
   const auto twin = mppi::vulkan::twin_of(model, &why);
@@ -85,7 +89,7 @@ Worst compare(const D& model, int device, int k, int t,
                        o);
   Worst w;
   const std::vector<float> x0 = start_state(D::kNx);
-  for (int step = 0; step < 2; ++step) {
+  for (int step = 0; step < steps; ++step) {
     mppi::StepSummary sc, sg;
     const auto uc = cpu.step(x0, &sc);
     const std::vector<float> u_cpu(uc.begin(), uc.end());
@@ -153,6 +157,36 @@ TEST_CASE("Vulkan parity: the low-pass and smooth samplers draw the CPU's number
     CHECK(w.cost_rel_p99 <= 1e-3);
     CHECK(w.control <= 1e-4);
   }
+}
+
+TEST_CASE("Vulkan parity: rollouts through the actuators' delay, rate limit and lag", "[vulkan][parity][actuators]") {
+  const int device = mppi::test::vulkan_test_device();
+  if (device < 0) return;
+  // Steering: 3 steps of delay, a slew of 4 / s and a 50-ms lag; throttle: 2 steps of delay
+  // alone. Over 4 steps the commands in flight are the controller's own earlier commands.
+  const std::vector<mppi::ActuatorChannel> chain = {{0.06f, 0.05f, 4.f}, {0.04f, 0.f, 0.f}};
+  const int k = 1000, t = 500;
+  const Worst w = compare(mppi::SingleTrack{}, device, k, t, mppi::SamplerKind::kGaussian, chain, 4);
+  INFO("worst cost rel. diff " << w.cost_rel << " (99th percentile " << w.cost_rel_p99
+                               << "), first-control diff " << w.control << ", sampled-control diff " << w.sampled);
+  CHECK(w.sampled_first <= 1e-6);
+  CHECK(w.sampled <= 1e-4);
+  CHECK(w.cost_rel_p99 <= 1e-3);
+  CHECK(w.control <= 1e-4);
+
+  // The chain changes the costs (so the comparison above would see a shader that ignored it):
+  // the same first step without it differs in most samples.
+  const mppi::ControllerOptions with = parity_options(k, t, mppi::SamplerKind::kGaussian, chain);
+  const mppi::ControllerOptions without = parity_options(k, t, mppi::SamplerKind::kGaussian);
+  mppi::Controller a = mppi::make_cpu_controller(mppi::SingleTrack{}, gazebo_cost(), with);
+  mppi::Controller b = mppi::make_cpu_controller(mppi::SingleTrack{}, gazebo_cost(), without);
+  const std::vector<float> x0 = start_state(mppi::SingleTrack::kNx);
+  a.step(x0);
+  b.step(x0);
+  int differ = 0;
+  for (int j = 0; j < k; ++j)
+    differ += std::abs(a.sampled_costs()[j] - b.sampled_costs()[j]) > 1e-2f * std::max(1.f, std::abs(b.sampled_costs()[j]));
+  CHECK(differ > k / 2);
 }
 
 TEST_CASE("Vulkan parity: kinematic bicycle, AutoRally cost", "[vulkan][parity]") {

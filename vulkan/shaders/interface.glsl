@@ -12,6 +12,12 @@ layout(std140, set = 0, binding = 0) uniform StepBlock {
   vec4 control_max;   // per control channel
   vec4 x0[4];         // start state, up to 16 entries
   vec4 noise_filter;  // the sampler's recursion (mppi/sampler.hpp): carry, first gain, gain, white (1/0)
+  // The actuators between command and model (mppi/actuator_chain.hpp), per control channel:
+  vec4 actuator_delay;       // pure delay in control steps (x, y); w = 1 when the chain is on
+  vec4 actuator_alpha;       // first-order lag factor (1: no lag)
+  vec4 actuator_max_change;  // rate limit per control step (FLT_MAX: none)
+  vec4 actuator_start;       // the chain's state at t = 0: rate output (x, y), lag output (z, w)
+  vec4 actuator_pending[16]; // the commands sent but not yet acting: channel c, step t at float c * 32 + t
 } step_data;
 
 layout(std430, set = 0, binding = 1) readonly buffer Nominal { float nominal[]; };   // T x nu

@@ -26,6 +26,13 @@ void main() {
   precise float gain = step_data.noise_filter.z;
   float eps[NU];
   [[unroll]] for (int ch = 0; ch < NU; ++ch) eps[ch] = 0.0;
+  // the actuator chain (mppi/actuator_chain.hpp): the model sees its output, not the command
+  bool actuated = step_data.actuator_delay.w != 0.0;
+  float rate_out[NU], lag_out[NU];
+  [[unroll]] for (int ch = 0; ch < NU; ++ch) {
+    rate_out[ch] = step_data.actuator_start[ch];
+    lag_out[ch] = step_data.actuator_start[2 + ch];
+  }
   for (int t = 0; t < horizon; ++t) {
     float u[NU];
     if (kGenerate) {
@@ -54,6 +61,21 @@ void main() {
       }
     } else {
       [[unroll]] for (int ch = 0; ch < NU; ++ch) u[ch] = controls[(uint(t) * NU + uint(ch)) * padded + k];
+    }
+    if (actuated) {
+      [[unroll]] for (int ch = 0; ch < NU; ++ch) {
+        int delay = int(step_data.actuator_delay[ch]);
+        // the command acting now: one sent before this plan, or this sample's own from t - delay
+        // (written to controls above by this invocation)
+        float cmd = t < delay ? step_data.actuator_pending[(ch * 32 + t) >> 2][t & 3]
+                              : (delay == 0 ? u[ch] : controls[(uint(t - delay) * NU + uint(ch)) * padded + k]);
+        precise float max_change = step_data.actuator_max_change[ch];
+        precise float r = rate_out[ch] + clamp(cmd - rate_out[ch], -max_change, max_change);
+        rate_out[ch] = r;
+        precise float a = lag_out[ch] + step_data.actuator_alpha[ch] * (r - lag_out[ch]);
+        lag_out[ch] = a;
+        u[ch] = a;
+      }
     }
     model_step(x, u[0], u[1], dt);
     cost += stage_cost(x, t);
