@@ -44,7 +44,13 @@ Controller make_controller(D model, C cost, const ControllerOptions& options, Ba
           if (backend) {
             r.backend = factory.name;
             r.reason = factory.describe(*backend, choice);
-            Controller controller(std::move(backend), options);
+            // The tube variants linearise the model on the CPU (64 lanes, one thread), beside
+            // the GPU's sampling.
+            std::unique_ptr<Backend> feedback;
+            if (options.variant != ControllerVariant::kPlain)
+              feedback = std::make_unique<CpuBackend<D, C>>(model, cost, 64, options.horizon, options.dt_s, 1,
+                                                            options.schedule);
+            Controller controller(std::move(backend), options, std::move(feedback));
             // A GPU can fail while running (a lost device): step() then goes on on the CPU.
             controller.set_fallback_backend([model, cost, options]() -> std::unique_ptr<Backend> {
               return std::make_unique<CpuBackend<D, C>>(model, cost, options.num_samples, options.horizon,

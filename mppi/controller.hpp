@@ -105,8 +105,12 @@ class Controller {
     std::string from, to, reason;
   };
 
-  Controller(std::unique_ptr<Backend> backend, ControllerOptions options)
-      : backend_(std::move(backend)), options_(std::move(options)) {
+  // `feedback_backend` (optional) serves the tube variants' linearisation and plan costs when
+  // `backend` cannot (a GPU backend: make_controller() adds a CPU backend of the same model
+  // and cost); it sees the same cost changes.
+  Controller(std::unique_ptr<Backend> backend, ControllerOptions options,
+             std::unique_ptr<Backend> feedback_backend = nullptr)
+      : backend_(std::move(backend)), feedback_backend_(std::move(feedback_backend)), options_(std::move(options)) {
     if (!backend_) throw Error("Controller: no backend");
     const RolloutShape& s = backend_->shape();
     std::string why;
@@ -132,10 +136,15 @@ class Controller {
     noise_filter_ = make_noise_filter(options_.sampler, options_.dt_s);
     lambda_ = options_.lambda;
     if (options_.variant != ControllerVariant::kPlain) {
-      if (!backend_->supports_feedback())
+      if (!linearising_backend())
         throw Error(std::string("ControllerOptions: the ") + variant_name(options_.variant) +
-                    " variant needs a backend that linearises its model (the CPU backend); the " +
-                    backend_->name() + " backend does not");
+                    " variant needs a backend that linearises its model (the CPU backend, or a CPU "
+                    "feedback backend beside the rollout backend); the " +
+                    backend_->name() + " backend does not and no feedback backend was given");
+      if (feedback_backend_ && feedback_backend_.get() == linearising_backend() &&
+          (feedback_backend_->shape().horizon != options_.horizon ||
+           feedback_backend_->shape().num_states != nx_ || feedback_backend_->shape().num_controls != nu_))
+        throw Error("Controller: the feedback backend's horizon, states and controls must match the rollout backend's");
       if (!check_ancillary_weights(options_.ancillary, nx_, nu_, &why)) throw Error("ControllerOptions: " + why);
       nominal_state_.assign(nx_, 0.f);
       measured_.assign(nx_, 0.f);
@@ -143,8 +152,8 @@ class Controller {
       gains_.assign(static_cast<std::size_t>(options_.horizon) * nu_ * nx_, 0.f);
       // size the backend's work for the feedback now, so that step() allocates nothing
       float unused = 0.f;
-      backend_->ancillary_gains(nominal_state_, nominal_, options_.ancillary, nominal_states_, gains_, nullptr);
-      backend_->plan_cost(nominal_state_, nominal_, &unused, nullptr);
+      linearising_backend()->ancillary_gains(nominal_state_, nominal_, options_.ancillary, nominal_states_, gains_, nullptr);
+      linearising_backend()->plan_cost(nominal_state_, nominal_, &unused, nullptr);
     }
     if (!options_.actuators.empty()) {
       if (!backend_->supports_actuators())
@@ -225,6 +234,8 @@ class Controller {
   // The changes are kept and applied again to a fallback backend when the controller switches.
   bool set_cost_param(std::string_view key, double value, std::string* why = nullptr) {
     if (!guarded(why, [&] { return backend_->set_cost_param(key, value, why); })) return false;
+    if (feedback_backend_ && !guarded(why, [&] { return feedback_backend_->set_cost_param(key, value, why); }))
+      return false;
     auto same_key = [&](const auto& kv) { return kv.first == key; };
     const auto it = std::find_if(cost_params_.begin(), cost_params_.end(), same_key);
     if (it != cost_params_.end()) it->second = value;
@@ -233,6 +244,7 @@ class Controller {
   }
   bool set_cost_map(std::shared_ptr<const CostMap> map, std::string* why = nullptr) {
     if (!guarded(why, [&] { return backend_->set_cost_map(map, why); })) return false;
+    if (feedback_backend_ && !guarded(why, [&] { return feedback_backend_->set_cost_map(map, why); })) return false;
     cost_map_ = std::move(map);
     return true;
   }
@@ -358,6 +370,13 @@ class Controller {
     return static_cast<float>(std::sqrt(d2));
   }
 
+  // The backend that linearises the model and costs single plans: the rollout backend if it
+  // can, else the feedback backend given at construction; nullptr if neither.
+  Backend* linearising_backend() const noexcept {
+    if (backend_->supports_feedback()) return backend_.get();
+    return feedback_backend_ && feedback_backend_->supports_feedback() ? feedback_backend_.get() : nullptr;
+  }
+
   // The state the iterations plan from (x0_ on return): the nominal state, or the measured
   // one where the variant's rule puts the nominal state back on it.
   void choose_nominal_state(StepSummary& sum) noexcept {
@@ -371,8 +390,9 @@ class Controller {
       // nominal state (by more than the margin); a backend error keeps the nominal state.
       float cost_measured = 0.f, cost_nominal = 0.f;
       try {
-        if (backend_->plan_cost(x0_, nominal_, &cost_measured, nullptr) &&
-            backend_->plan_cost(nominal_state_, nominal_, &cost_nominal, nullptr))
+        Backend* feedback = linearising_backend();
+        if (feedback && feedback->plan_cost(x0_, nominal_, &cost_measured, nullptr) &&
+            feedback->plan_cost(nominal_state_, nominal_, &cost_nominal, nullptr))
           reset = !(cost_measured > cost_nominal + options_.robust_cost_margin);
       } catch (...) {
       }
@@ -389,7 +409,8 @@ class Controller {
   void apply_feedback(StepSummary& sum) noexcept {
     bool ok = false;
     try {
-      ok = backend_->ancillary_gains(nominal_state_, nominal_, options_.ancillary, nominal_states_, gains_, nullptr);
+      Backend* feedback = linearising_backend();
+      ok = feedback && feedback->ancillary_gains(nominal_state_, nominal_, options_.ancillary, nominal_states_, gains_, nullptr);
     } catch (...) {
     }
     if (!ok) {
@@ -589,6 +610,7 @@ class Controller {
   }
 
   std::unique_ptr<Backend> backend_;
+  std::unique_ptr<Backend> feedback_backend_;  // optional: linearises for a backend that cannot
   ControllerOptions options_;
   int nu_ = 0, nx_ = 0, padded_ = 0, threads_ = 1;
   std::unique_ptr<ParallelRunner> runner_;  // the CPU threads of sampling and the weighted sum

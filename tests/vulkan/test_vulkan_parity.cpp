@@ -189,6 +189,66 @@ TEST_CASE("Vulkan parity: rollouts through the actuators' delay, rate limit and 
   CHECK(differ > k / 2);
 }
 
+TEST_CASE("Vulkan parity: Tube-MPPI and Robust MPPI sample on the GPU, linearise on the CPU", "[vulkan][parity][tube]") {
+  const int device = mppi::test::vulkan_test_device();
+  if (device < 0) return;
+  const int k = 1000, t = 100;
+  for (auto variant : {mppi::ControllerVariant::kTube, mppi::ControllerVariant::kRobust}) {
+    mppi::ControllerOptions o = parity_options(k, t, mppi::SamplerKind::kGaussian);
+    o.variant = variant;
+    o.tube_reset_distance = 5.f;
+    mppi::Controller cpu = mppi::make_cpu_controller(mppi::SingleTrack{}, gazebo_cost(), o);
+    std::string why;
+    const auto twin = mppi::vulkan::twin_of(mppi::SingleTrack{}, &why);
+    REQUIRE(twin);
+    // Without a feedback backend the GPU backend cannot serve a tube variant.
+    CHECK_THROWS_WITH(mppi::Controller(std::make_unique<mppi::vulkan::VulkanBackend>(*twin, gazebo_cost(), k, t, o.dt_s, device), o),
+                      Catch::Contains("linearises its model"));
+    mppi::Controller gpu(std::make_unique<mppi::vulkan::VulkanBackend>(*twin, gazebo_cost(), k, t, o.dt_s, device), o,
+                         std::make_unique<mppi::CpuBackend<mppi::SingleTrack, mppi::AutoRallyCost>>(
+                             mppi::SingleTrack{}, gazebo_cost(), 64, t, o.dt_s, 1));
+    // The measured state drifts from the nominal one (a lateral push), so the feedback acts.
+    std::vector<float> x = start_state(mppi::SingleTrack::kNx);
+    double worst_control = 0, worst_gain = 0, worst_state = 0;
+    int applied = 0;
+    for (int step = 0; step < 4; ++step) {
+      x[mppi::state::kY] += 0.05f;
+      mppi::StepSummary sc, sg;
+      const auto uc = cpu.step(x, &sc);
+      const std::vector<float> u_cpu(uc.begin(), uc.end());
+      const auto ug = gpu.step(x, &sg);
+      REQUIRE(sg.status == mppi::StepStatus::kOk);
+      CHECK(sg.nominal_reset == sc.nominal_reset);
+      CHECK(sg.tube_distance == Approx(sc.tube_distance).margin(1e-4));
+      applied += sg.feedback_applied && sc.feedback_applied;
+      for (int c = 0; c < 2; ++c) worst_control = std::max(worst_control, static_cast<double>(std::abs(u_cpu[c] - ug[c])));
+      const auto gc = cpu.feedback_gains();
+      const auto gg = gpu.feedback_gains();
+      REQUIRE(gc.size() == gg.size());
+      for (std::size_t i = 0; i < gc.size(); ++i)
+        worst_gain = std::max(worst_gain, std::abs(static_cast<double>(gc[i]) - gg[i]) / std::max(1.0, std::abs(static_cast<double>(gc[i]))));
+      const auto nc = cpu.nominal_states();
+      const auto ng = gpu.nominal_states();
+      for (std::size_t i = 0; i < nc.size(); ++i)
+        worst_state = std::max(worst_state, std::abs(static_cast<double>(nc[i]) - ng[i]) / std::max(1.0, std::abs(static_cast<double>(nc[i]))));
+    }
+    INFO(mppi::variant_name(variant) << ": control diff " << worst_control << ", gain rel. diff " << worst_gain
+                                      << ", nominal-state rel. diff " << worst_state);
+    CHECK(applied == 4);
+    CHECK(worst_control <= 1e-3);
+    CHECK(worst_gain <= 1e-2);
+    CHECK(worst_state <= 1e-3);
+
+    // make_controller() gives a tube variant on Vulkan its CPU feedback backend.
+    mppi::BackendReport report;
+    mppi::Controller made = mppi::make_controller(mppi::SingleTrack{}, gazebo_cost(), o, mppi::BackendChoice::kVulkan, &report);
+    CHECK(report.backend == "vulkan");
+    mppi::StepSummary sm;
+    made.step(start_state(mppi::SingleTrack::kNx), &sm);
+    CHECK(sm.status == mppi::StepStatus::kOk);
+  }
+}
+
 TEST_CASE("Vulkan parity: kinematic bicycle, AutoRally cost", "[vulkan][parity]") {
   check_parity(mppi::KinematicBicycle{}, "kinematic");
 }
