@@ -442,6 +442,7 @@ PYBIND11_MODULE(mppi, m) {
       .def_readwrite("stall_progress_m", &Cfg::stall_progress_m)
       .def_readwrite("controller", &Cfg::controller)
       .def_readwrite("cost_params_yaml", &Cfg::cost_params_yaml)
+      .def_readwrite("cost_map_npz", &Cfg::cost_map_npz)
       .def_readwrite("plant_params_yaml", &Cfg::plant_params_yaml)
       .def_readwrite("model_params_yaml", &Cfg::model_params_yaml)
       .def_readwrite("network_npz", &Cfg::network_npz)

@@ -169,6 +169,10 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
   add_backend_option(app, c.backend);
   app.add_option("--cost-config", c.cost_params_yaml, "AutoRally cost weights (YAML; default data/config)")
       ->type_name("FILE");
+  app.add_option("--cost-map", c.cost_map_npz,
+                 "the controller's cost map (AutoRally .npz; default: the track's own; --limit-lap writes one "
+                 "around the racing line)")
+      ->type_name("FILE");
   app.add_option("--plant-params", c.plant_params_yaml,
                  "the plant's data file (YAML parameters, or a corrected-model file; keys: --list-models)")
       ->type_name("FILE");

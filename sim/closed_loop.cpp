@@ -487,7 +487,8 @@ RunSummary run_closed_loop(const ClosedLoopConfig& given) {
   AutoRallyCostParams cost_params = load_autorally_cost_params(
       config.cost_params_yaml.empty() ? data_file(kDefaultCostYaml) : config.cost_params_yaml);
   cost_params.target_speed_mps = static_cast<float>(config.target_speed_mps);
-  const AutoRallyCost cost(std::make_shared<const CostMap>(CostMap::load_npz(track.costmap_path())),
+  const AutoRallyCost cost(std::make_shared<const CostMap>(CostMap::load_npz(
+                               config.cost_map_npz.empty() ? track.costmap_path() : config.cost_map_npz)),
                            cost_params);
   if (config.laps < 1) throw Error("laps must be >= 1");
   for (std::size_t i = 0; i < config.target_speed_schedule.size(); ++i) {

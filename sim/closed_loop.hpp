@@ -46,6 +46,7 @@ struct ClosedLoopConfig {
   BackendChoice backend = BackendChoice::kCpu;  // rollout backend: cpu | vulkan | auto (factory/make_controller.hpp)
   BackendReport* backend_report = nullptr;  // if set, receives the backend that ran and why
   std::string cost_params_yaml;           // AutoRally cost weights; empty = data/config default
+  std::string cost_map_npz;               // the controller's cost map; empty = the track's own
   std::string plant_params_yaml;          // plant's data file; empty = its default (data/config)
   std::string model_params_yaml;          // controller model's data file; empty = its default
   std::string network_npz;                // weights (npz) for learned models; empty = the shipped ones

@@ -81,6 +81,7 @@ void require_same(const SimCommandLine& a, const SimCommandLine& b) {
   CHECK(p.schedule == q.schedule);
   CHECK(x.backend == y.backend);
   CHECK(x.cost_params_yaml == y.cost_params_yaml);
+  CHECK(x.cost_map_npz == y.cost_map_npz);
   CHECK(x.plant_params_yaml == y.plant_params_yaml);
   CHECK(x.model_params_yaml == y.model_params_yaml);
   CHECK(x.network_npz == y.network_npz);
@@ -106,7 +107,7 @@ const std::vector<std::string> kFlags = {
     "--speed", "7.25", "--laps", "2", "--max-time", "30.5", "--samples", "256", "--horizon", "60",
     "--iterations", "2", "--lambda", "4.5", "--smoothing", "9", "--seed", "12345678901", "--threads", "3",
     "--steer-rate-limit", "12.5", "--throttle-rate-limit", "7.5",
-    "--backend", "cpu", "--cost-config", "my cost.yaml", "--plant-params", "plant.yaml", "--model-params",
+    "--backend", "cpu", "--cost-config", "my cost.yaml", "--cost-map", "map.npz", "--plant-params", "plant.yaml", "--model-params",
     "model.yaml", "--network", "net.npz", "--out", "out/x: y", "--json", "--quiet", "--data-dir", kDataDir};
 const std::string kRunFile = R"(track: marietta
 clockwise: true
@@ -126,6 +127,7 @@ throttle-rate-limit: 7.5
 threads: 3
 backend: cpu
 cost-config: my cost.yaml
+cost-map: map.npz
 plant-params: plant.yaml
 model-params: model.yaml
 network: net.npz
@@ -159,6 +161,7 @@ TEST_CASE("cli: the flags set the configuration they name", "[cli]") {
   c.actuators.throttle_rate_per_s = 7.5f;
   c.backend = mppi::BackendChoice::kCpu;
   c.cost_params_yaml = "my cost.yaml";
+  c.cost_map_npz = "map.npz";
   c.plant_params_yaml = "plant.yaml";
   c.model_params_yaml = "model.yaml";
   c.network_npz = "net.npz";
