@@ -52,7 +52,7 @@ def plan(adapter, tasks):
 def _progress_in_background(futures):
     """Dask's text progress bar in a thread, while the caller collects the results as they come."""
     from distributed import progress
-    thread = threading.Thread(target=progress, args=(futures,), kwargs={'notebook': False}, daemon=True)
+    thread = threading.Thread(target=progress, args=(futures,), kwargs={'notebook': False, 'interval': '2s'}, daemon=True)
     thread.start()
     return thread
 

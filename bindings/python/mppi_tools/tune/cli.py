@@ -54,7 +54,8 @@ def cmd_run(args):
     os.makedirs(args.out, exist_ok=True)
     url = args.storage or f'sqlite:///{os.path.abspath(os.path.join(args.out, "study.db"))}'
     st = study.create(url, args.study, args.sampler_seed)
-    study.enqueue_defaults(st, params)
+    if args.serial:  # parallel workers would race for a queued trial (Optuna hands it to each that asks)
+        study.enqueue_defaults(st, params)
     already = len(st.trials)
     print(f'[tune] study {args.study} in {url}: {already} trials before, {args.trials} to run; '
           f'{len(params)} parameters ({", ".join(p.name for p in params)}); each trial {len(evaluation.runs({}))} runs '
@@ -72,7 +73,7 @@ def cmd_run(args):
             futures = [client.submit(study.run_trial, url, args.study, params, fixed, evaluation,
                                      args.sampler_seed + already + n, pure=False, key=f'trial-{already + n}')
                        for n in range(args.trials)]
-            threading.Thread(target=progress, args=(futures,), kwargs={'notebook': False}, daemon=True).start()
+            threading.Thread(target=progress, args=(futures,), kwargs={'notebook': False, 'interval': '2s'}, daemon=True).start()
             for future in as_completed(futures):
                 print(f'\n[tune] {future.result()}', flush=True)
     finally:
