@@ -52,6 +52,8 @@ def dashboard_text(client):
 def close_client(client):
     """Closes the client and a LocalCluster it started."""
     cluster = getattr(client, 'cluster', None)
+    # The progress bar's feed on the scheduler is cancelled as it closes; that is not an error.
+    logging.getLogger('distributed.core').setLevel(logging.CRITICAL)
     client.close()
     if cluster is not None:
         cluster.close()

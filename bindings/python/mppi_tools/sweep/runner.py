@@ -87,7 +87,7 @@ def run_sweep(adapter, tasks, table_path, client=None, log=print):
         bar = _progress_in_background(futures)
         for future in as_completed(futures):
             record(future.result())
-        bar.join(timeout=5)
+        bar.join(timeout=10)  # the bar ends with its futures; closing the client under it would cancel it
         print(flush=True)
     if todo:
         log(f'[sweep] {len(todo) - len(failures)} ran, {len(failures)} failed in {time.monotonic() - start:.1f} s'

@@ -73,9 +73,12 @@ def cmd_run(args):
             futures = [client.submit(study.run_trial, url, args.study, params, fixed, evaluation,
                                      args.sampler_seed + already + n, pure=False, key=f'trial-{already + n}')
                        for n in range(args.trials)]
-            threading.Thread(target=progress, args=(futures,), kwargs={'notebook': False, 'interval': '2s'}, daemon=True).start()
+            bar = threading.Thread(target=progress, args=(futures,), kwargs={'notebook': False, 'interval': '2s'},
+                                   daemon=True)
+            bar.start()
             for future in as_completed(futures):
                 print(f'\n[tune] {future.result()}', flush=True)
+            bar.join(timeout=10)  # the bar ends with its futures; closing the client under it would cancel it
     finally:
         if client is not None:
             close_client(client)

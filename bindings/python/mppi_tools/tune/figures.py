@@ -47,8 +47,8 @@ def importance_panel(importance):
     for i, name in enumerate(names, 1):
         value = importance[name]
         xs, ys = [], []
-        for k in range(9):
-            x = i - 0.3 + 0.6 * k / 8
+        for k in range(17):
+            x = i - 0.3 + 0.6 * k / 16
             xs += [x, x]
             ys += [0.0, value] if k % 2 == 0 else [value, 0.0]
         series.append({'x': xs, 'y': ys, 'colour': BLUE, 'width_px': 2.0})
@@ -71,5 +71,5 @@ def draw(figure, json_path, png_path, bin_dir=None):
     return png_path
 
 
-def single(panel, title):
-    return {'title': title, 'columns': 1, 'panel_width_px': 900, 'panel_height_px': 420, 'panels': [panel]}
+def single(panel, title, width_px=900):
+    return {'title': title, 'columns': 1, 'panel_width_px': width_px, 'panel_height_px': 420, 'panels': [panel]}

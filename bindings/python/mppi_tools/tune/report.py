@@ -64,7 +64,8 @@ def write_all(study, out_dir, bin_dir=None):
         os.path.join(out_dir, 'importance.csv'), index=False)
     if imp:
         figures.draw(figures.single(figures.importance_panel(imp),
-                                    f'{study.study_name}: parameter importances (feasible trials)'),
+                                    f'{study.study_name}: parameter importances (feasible trials)',
+                                    width_px=max(900, 150 + 8 * len(', '.join(f'{i} {n}' for i, n in enumerate(imp))))),
                      os.path.join(out_dir, 'importance.json'), os.path.join(out_dir, 'importance.png'), bin_dir)
     return records, imp
 
