@@ -14,6 +14,8 @@ import os
 import subprocess
 import tempfile
 
+import yaml
+
 from .. import paths, runfile
 from ..errors import ToolError
 from .figures import run_figures
@@ -164,6 +166,11 @@ class SimProcess:
             return run_figures(json.load(f))
 
 
+# The figures of an evidence case: keys of its runs.jsonl line (diagnose/evidence_sweep.cpp).
+EVIDENCE_FIGURES = ('track', 'direction', 'driver', 'crashes', 'named', 'right', 'right_strict', 'wrong',
+                    'heldout_1s_nrmse_clean_before', 'heldout_1s_nrmse_clean_after', 'reduction')
+
+
 class EvidenceCase:
     """One case of the evidence grid, by label (settings: case, and the grid's options as
     mppi-fit flags without dashes, e.g. reduced: true, duration: 60)."""
@@ -191,14 +198,14 @@ class EvidenceCase:
             run = json.loads(f.readline())
         if run.get('error'):
             raise ToolError(f'case {label}: {run["error"]}')
-        return {k: run[k] for k in ('track', 'direction', 'driver', 'crashes', 'named', 'right', 'right_strict',
-                                    'wrong', 'before_clean', 'after_clean') if k in run}
+        return {k: run[k] for k in EVIDENCE_FIGURES}
 
 
 class FitCommand:
     """Any mppi-fit command with a run folder: settings {'command': 'diagnose' (words of the
-    subcommand), 'result': 'report.json' (a JSON file it writes in --out DIR), and its flags
-    without dashes}. The figures: the result's top-level numbers, strings and booleans."""
+    subcommand), 'result': 'report.json' (a JSON or YAML file it writes in --out DIR: diagnose's
+    report.json, calibrate's calibrated.yaml), and its flags
+    without dashes}. The figures: the result's top-level numbers, strings and booleans, as result.KEY."""
     kind = 'fit_command'
 
     def __init__(self, out_root, bin_dir=None):
@@ -223,8 +230,11 @@ class FitCommand:
         if rc != 0 or not os.path.exists(path):
             raise ToolError(f'mppi-fit {" ".join(command_words)} exited {rc} without {result} (see {out}/mppi_fit.log)')
         with open(path) as f:
-            data = json.load(f)
-        return {k: v for k, v in data.items() if isinstance(v, (int, float, str, bool))}
+            data = json.load(f) if path.endswith('.json') else yaml.safe_load(f)
+        if not isinstance(data, dict):
+            raise ToolError(f'{path}: expected a JSON or YAML mapping')
+        # prefixed: a result repeats some of the settings (the log, the holdout)
+        return {f'result.{k}': v for k, v in data.items() if isinstance(v, (int, float, str, bool))}
 
 
 def make_adapter(kind, out_root, bin_dir=None):
