@@ -34,6 +34,8 @@ const char* kEvidenceUsage = R"(usage:
         [--stability-resamples N] [--min-inclusion F]  (the diagnosis' stability selection, as in diagnose)
         [--summarize DIR]  (only the table, from DIR/runs.jsonl of a sweep, finished or not)
         [--resume]  (keep the runs DIR/runs.jsonl already has, run the rest; same options as before)
+        [--list-cases]  (print the grid's case labels, one a line, and exit)
+        [--cases A,B]  (run only the grid's cases with these labels, e.g. steer_delay_large_s1)
         (full grid: 5 seeds, every effect at both sizes, 8 pairs, 20 effect-free; --reduced: 1 seed,
         3 pairs, 4 effect-free). Writes DIR/runs.jsonl, DIR/evidence_sweep.md, DIR/evidence_sweep.json.
 Effects (key=value keys are the fields of evidence/truth_effects.hpp):
@@ -114,7 +116,8 @@ int evidence_synth(int argc, char** argv) {
 
 int evidence_sweep(int argc, char** argv) {
   diagnose::EvidenceGrid grid;
-  bool reduced = false, resume = false;
+  bool reduced = false, resume = false, list_cases = false;
+  std::vector<std::string> only_cases;
   int seeds = -1, pairs = -1, clean = -1, jobs = 1;
   std::vector<std::string> sizes, effects;
   double duration = 60;
@@ -129,6 +132,8 @@ int evidence_sweep(int argc, char** argv) {
     if (f == "--generator") value();
     else if (f == "--reduced") reduced = true;
     else if (f == "--resume") resume = true;
+    else if (f == "--list-cases") list_cases = true;
+    else if (f == "--cases") only_cases = split_list(value());
     else if (f == "--seeds") seeds = static_cast<int>(number(f, value()));
     else if (f == "--pairs") pairs = static_cast<int>(number(f, value()));
     else if (f == "--clean") clean = static_cast<int>(number(f, value()));
@@ -177,7 +182,20 @@ int evidence_sweep(int argc, char** argv) {
   grid.effects = effects;
   grid.duration_s = duration;
   grid.vehicle_yaml = vehicle;
-  const auto cases = diagnose::evidence_cases(grid);
+  auto cases = diagnose::evidence_cases(grid);
+  if (list_cases) {
+    for (const auto& c : cases) std::printf("%s\n", c.label().c_str());
+    return 0;
+  }
+  if (!only_cases.empty()) {
+    std::vector<diagnose::EvidenceCase> kept;
+    for (const auto& label : only_cases) {
+      const auto it = std::find_if(cases.begin(), cases.end(), [&](const auto& c) { return c.label() == label; });
+      if (it == cases.end()) throw UsageError("--cases: '" + label + "' is not a case of this grid (--list-cases)");
+      kept.push_back(*it);
+    }
+    cases = std::move(kept);
+  }
   std::filesystem::create_directories(out);
   std::vector<diagnose::EvidenceRun> runs(cases.size());
   std::vector<char> done(cases.size(), 0);

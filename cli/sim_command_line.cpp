@@ -107,6 +107,10 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
       ->type_name("N")
       ->check(CLI::Range(0, 1000));
   add_float_option(app, "--lambda", mppi.lambda, "MPPI temperature")->type_name("L");
+  add_float_list_option(app, "--noise-std", mppi.noise_std,
+                        "standard deviation of the sampled perturbations per control channel (steering, "
+                        "throttle), comma-separated")
+      ->type_name("S,...");
   app.add_option("--smoothing", mppi.smoothing_window, "Savitzky-Golay window over the plan (odd, <= the horizon; upstream AutoRally: 5), 0 = off")
       ->type_name("W");
   app.add_option_function<std::string>(

@@ -7,6 +7,12 @@ on the built-in tracks with mppi-sim; the runs' summary.json files are reduced t
 
     /usr/bin/python3 scripts/robustness_benchmark.py [--quick] [--variants a,b] [--plants x,y]
                                                      [--jobs N] [--out DIR] [--bin DIR]
+                                                     [--dask [tcp://HOST:8786]] [--workers N]
+
+With --dask the runs are Dask tasks (one mppi-sim process each, --threads 1): on a LocalCluster of
+--workers processes, or on the scheduler named (a cluster of dask-scheduler / dask-worker; the
+run folders must be on a file system every worker shares); their figures also go to
+OUT/sweep.csv (docs/TUNING.md).
 
 Runs whose summary.json exists are not run again: a rerun resumes, and one with more variants
 or plants runs only the new cells. Debian's python3 with the standard library (numpy and
@@ -148,6 +154,32 @@ def execute(run, binary, threads):
     if not os.path.exists(run.summary_path):
         return run, seconds, f'mppi-sim exited {rc} without a summary (see {run.dir}/mppi_sim.log)'
     return run, seconds, None
+
+
+def run_all_on_dask(runs, bin_dir, address, workers, out):
+    """The runs not yet done as Dask tasks (mppi_tools.sweep, bindings/python); failures as run_all's."""
+    sys.path.insert(0, os.path.join(ROOT, 'bindings', 'python'))
+    from mppi_tools.runfile import flags_to_settings
+    from mppi_tools.sweep import SimProcess, close_client, open_client, run_sweep
+    todo = [r for r in runs if not os.path.exists(r.summary_path)]
+    print(f'{len(runs)} runs, {len(runs) - len(todo)} done before, {len(todo)} to run (Dask tasks, --threads 1 each)',
+          flush=True)
+    if not todo:
+        return []
+    from mppi_tools.sweep import task_key
+    tasks, run_of = [], {}
+    for r in todo:
+        settings = flags_to_settings(r.command('mppi-sim', 1)[1:])  # 'out' is the run's folder
+        settings.pop('quiet', None)
+        tasks.append(settings)
+        run_of[task_key(SimProcess.kind, settings)] = r
+    client = open_client(address, workers)
+    try:
+        _, failed = run_sweep(SimProcess(os.path.join(out, 'runs'), bin_dir), tasks, os.path.join(out, 'sweep.csv'),
+                              client)
+    finally:
+        close_client(client)
+    return [(run_of[f['key']], f['error']) for f in failed]
 
 
 def format_duration(seconds):
@@ -385,6 +417,9 @@ def main():
     parser.add_argument('--variants', help='comma-separated variant names (default: all in the variants file)')
     parser.add_argument('--plants', help='comma-separated plant rows (default: all): ' + ', '.join(PLANT_ROWS))
     parser.add_argument('--jobs', type=int, default=1, help='mppi-sim processes at a time')
+    parser.add_argument('--dask', nargs='?', const='', metavar='ADDRESS',
+                        help='run on Dask: a LocalCluster (no ADDRESS) or the scheduler at ADDRESS (tcp://HOST:8786)')
+    parser.add_argument('--workers', type=int, default=2, help='with --dask and no ADDRESS: LocalCluster workers')
     parser.add_argument('--out', default='results/robustness', help='run folders and the figure JSON')
     parser.add_argument('--bin', default='build/bin', help='folder of mppi-sim and mppi-plot')
     parser.add_argument('--variants-file', default=VARIANTS_FILE)
@@ -419,7 +454,13 @@ def main():
 
     runs = plan_runs(variants, plants, groups, args.out)
     started = time.monotonic()
-    failures = run_all(runs, mppi_sim, args.jobs)
+    if args.dask is None:
+        failures = run_all(runs, mppi_sim, args.jobs)
+    else:
+        try:
+            failures = run_all_on_dask(runs, os.path.abspath(args.bin), args.dask or None, args.workers, args.out)
+        except RuntimeError as e:  # mppi_tools' ToolError: a bad address, an unreachable scheduler
+            sys.exit(f'robustness_benchmark: {e}')
     cells = reduce_cells(runs)
 
     mode = 'quick (--quick)' if args.quick else 'full'

@@ -8,6 +8,7 @@ MPPI_DEBIAN_PACKAGES=(
   libeigen3-dev libtbb-dev libzip-dev libyaml-cpp-dev libopencv-dev librandom123-dev
   nlohmann-json3-dev catch2 libbenchmark-dev libcli11-dev
   python3 python3-numpy python3-dev python3-pytest pybind11-dev
+  python3-distributed python3-optuna python3-pandas python3-sqlalchemy
   mesa-vulkan-drivers libvulkan-dev glslang-tools spirv-tools
   libplplot-dev plplot-driver-cairo fonts-dejavu-core libcmark-gfm-dev libcmark-gfm-extensions-dev
   libcpp-httplib-dev nodejs npm chromium

@@ -105,7 +105,7 @@ const std::string kDataDir = MPPI_TEST_DATA_DIR;
 const std::vector<std::string> kFlags = {
     "--track", "marietta", "--clockwise", "--model", "single-track", "--plant", "double-track",
     "--speed", "7.25", "--laps", "2", "--max-time", "30.5", "--samples", "256", "--horizon", "60",
-    "--iterations", "2", "--lambda", "4.5", "--smoothing", "9", "--seed", "12345678901", "--threads", "3",
+    "--iterations", "2", "--lambda", "4.5", "--noise-std", "0.2,0.45", "--smoothing", "9", "--seed", "12345678901", "--threads", "3",
     "--steer-rate-limit", "12.5", "--throttle-rate-limit", "7.5",
     "--backend", "cpu", "--cost-config", "my cost.yaml", "--cost-map", "map.npz", "--plant-params", "plant.yaml", "--model-params",
     "model.yaml", "--network", "net.npz", "--out", "out/x: y", "--json", "--quiet", "--data-dir", kDataDir};
@@ -120,6 +120,7 @@ samples: 256
 horizon: 60
 iterations: 2
 lambda: 4.5
+noise-std: 0.2,0.45
 smoothing: 9
 seed: 12345678901
 steer-rate-limit: 12.5
@@ -154,6 +155,7 @@ TEST_CASE("cli: the flags set the configuration they name", "[cli]") {
   c.controller.horizon = 60;
   c.controller.iterations = 2;
   c.controller.lambda = 4.5f;
+  c.controller.noise_std = {0.2f, 0.45f};
   c.controller.smoothing_window = 9;
   c.controller.seed = 12345678901ull;
   c.controller.num_threads = 3;

@@ -1,0 +1,1 @@
+"""The controller's tuner on Optuna, trials on Dask (docs/TUNING.md)."""
