@@ -10,7 +10,7 @@ MPPI_DEBIAN_PACKAGES=(
   python3 python3-numpy python3-dev python3-pytest pybind11-dev
   mesa-vulkan-drivers libvulkan-dev glslang-tools spirv-tools
   libplplot-dev plplot-driver-cairo fonts-dejavu-core libcmark-gfm-dev libcmark-gfm-extensions-dev
-  libcpp-httplib-dev nodejs npm chromium
+  libcpp-httplib-dev libssl-dev nodejs npm chromium
 )
 
 mppi_missing_packages() {
