@@ -48,11 +48,15 @@ std::unique_ptr<httplib::Server> make_http_server(const ServerSettings& s) {
                   "accept that risk (docs/SECURITY.md)");
     return std::make_unique<httplib::Server>();
   }
+#ifdef CPPHTTPLIB_OPENSSL_SUPPORT
   auto tls = std::make_unique<httplib::SSLServer>(a.tls_cert_file.c_str(), a.tls_key_file.c_str());
   if (!tls->is_valid())
     throw Error("ocs server: cannot use the TLS certificate " + a.tls_cert_file + " with the key " +
                 a.tls_key_file + " (missing, unreadable, not PEM, or not a pair)");
   return tls;
+#else
+  throw Error("ocs server: this build's cpp-httplib has no OpenSSL support, so no HTTPS (Debian's libcpp-httplib-dev has)");
+#endif
 }
 
 // The page comes after the controller: every thread of the server runs under SCHED_IDLE, so it
@@ -158,6 +162,10 @@ void OcsServer::publish_loop() {
 
 void OcsServer::add_routes() {
   httplib::Server& s = *http_;
+  // The token is in the page's address: no Referer carries it away, no other site frames the page.
+  s.set_default_headers({{"Referrer-Policy", "no-referrer"},
+                         {"X-Frame-Options", "DENY"},
+                         {"X-Content-Type-Options", "nosniff"}});
   // Before any route: the request must come through this page's own host and origin, and carry
   // the token if it would change anything (page_access.hpp).
   s.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {

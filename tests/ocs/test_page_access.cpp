@@ -99,9 +99,12 @@ TEST_CASE("the server refuses other sites and requests without the token with 40
   auto post = [&](const httplib::Headers& headers) {
     return client.Post("/api/control", headers, "runstop=1&target_speed=3", "application/x-www-form-urlencoded");
   };
-  // Reading stays open.
+  // Reading stays open; the page cannot be framed and leaks no Referer.
   CHECK(client.Get("/api/info")->status == 200);
-  CHECK(client.Get("/")->status == 200);
+  auto index = client.Get("/");
+  CHECK(index->status == 200);
+  CHECK(index->get_header_value("Referrer-Policy") == "no-referrer");
+  CHECK(index->get_header_value("X-Frame-Options") == "DENY");
   // Refused, and nothing changed.
   auto missing = post({});
   CHECK(missing->status == 403);
