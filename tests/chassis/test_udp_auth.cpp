@@ -75,7 +75,7 @@ TEST_CASE("HMAC-SHA256 matches RFC 4231's test vectors", "[chassis][udp][auth]")
         "60e431591ee0b67f0d8a26aacbf5b77f8e0bc6213728c5140546040f0ee37f54");  // test case 6
 }
 
-TEST_CASE("a datagram signed by Python's hmac module decodes; ours is byte for byte the same",
+TEST_CASE("a datagram signed by Python's hmac module decodes and ours is byte for byte the same",
           "[chassis][udp][auth]") {
   const Key key = Key::from_hex(kKeyHex);
   const Bytes python = from_hex(kPythonSignedRunstop);

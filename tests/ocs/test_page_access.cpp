@@ -36,7 +36,7 @@ TEST_CASE("tokens: random, 64 hex digits, compared in full", "[ocs][access]") {
   CHECK_FALSE(mppi::ocs::same_secret(a, ""));
 }
 
-TEST_CASE("a state-changing request needs the right token; reading needs none", "[ocs][access]") {
+TEST_CASE("a state-changing request needs the right token and reading needs none", "[ocs][access]") {
   const AccessRules r = rules();
   const std::string host = "127.0.0.1:8080";
   CHECK(refusal(r, host, kNone, kToken, true).empty());                        // right
@@ -135,7 +135,7 @@ TEST_CASE("the server refuses other sites and requests without the token with 40
   server.stop();
 }
 
-TEST_CASE("no plain HTTP off loopback unless asked for; TLS needs a usable certificate", "[ocs][access]") {
+TEST_CASE("no plain HTTP off loopback unless asked for, and TLS needs a usable certificate", "[ocs][access]") {
   mppi::ocs::ServerSettings s;
   s.port = 0;
   s.bind_address = "0.0.0.0";
