@@ -12,6 +12,7 @@
 #include "sim/limit_lap_report.hpp"
 #include "sim/summary.hpp"
 #ifdef MPPI_HAVE_OCS
+#include "apps/page_options.hpp"
 #include "ocs/serve.hpp"
 #endif
 
@@ -22,9 +23,15 @@ int main(int argc, char** argv) {
   int serve_port = -1;
   bool serve_fast = false;
   std::string replay_csv;
-  app.add_option("--serve", serve_port, "operator page on http://127.0.0.1:PORT/ while driving, in real time (docs/OCS.md)")
+  app.add_option("--serve", serve_port,
+                 "operator page on http://127.0.0.1:PORT/ while driving, in real time; open the URL it prints "
+                 "(with the page's token) (docs/OCS.md)")
       ->type_name("PORT")
       ->check(CLI::Range(0, 65535));
+#ifdef MPPI_HAVE_OCS
+  mppi::ocs::ServeOptions serve;
+  mppi::apps::add_page_options(app, serve.bind_address, serve.access);
+#endif
   app.add_flag("--fast", serve_fast, "with --serve: do not hold the simulation to wall-clock time");
   app.add_option("--replay", replay_csv, "serve FILE (a recording) on the operator page for replay (with --serve PORT)")
       ->type_name("FILE");
@@ -49,7 +56,6 @@ int main(int argc, char** argv) {
       return 0;
     }
 #ifdef MPPI_HAVE_OCS
-    mppi::ocs::ServeOptions serve;
     serve.port = serve_port;
     serve.realtime = !serve_fast;
     if (!replay_csv.empty()) {

@@ -2,7 +2,8 @@
 // A stack in any language sends command and runstop datagrams (docs/CHASSIS.md) to
 // 127.0.0.1:47800; the bridge runs the chassis at a fixed rate (priorities, runstop, watchdog,
 // calibration to pulse widths), drives the built-in single-track car with the pulse widths in
-// real time and answers every client with state datagrams. On exit it prints the datagram
+// real time and answers every client with state datagrams. With --key FILE every datagram is
+// authenticated (HMAC-SHA256; off loopback the key is required). On exit it prints the datagram
 // counters by rejection reason and the chassis loop's deadline statistics.
 #include <atomic>
 #include <csignal>
@@ -32,7 +33,7 @@ void on_signal(int) { g_stop = true; }
 int main(int argc, char** argv) {
   using namespace mppi;
   using namespace mppi::chassis;
-  std::string bind = "127.0.0.1", calibration_file, priorities_file, track_name = "gazebo";
+  std::string bind = "127.0.0.1", calibration_file, priorities_file, track_name = "gazebo", key_file;
   int port = udp::kDefaultPort;
   double rate_hz = 100.0, duration_s = 0.0;
   bool quiet = false;
@@ -42,6 +43,9 @@ int main(int argc, char** argv) {
   cli::configure(app);
   app.add_option("--bind", bind, "IPv4 address to listen on (127.0.0.1: loopback only)")->type_name("ADDR");
   app.add_option("--port", port, "UDP port")->type_name("N")->check(CLI::Range(0, 65535).description(""));
+  app.add_option("--key", key_file,
+                 "authenticate datagrams with this key file (64 hex digits, mode 600; required off loopback)")
+      ->type_name("FILE");
   app.add_option("--rate", rate_hz, "chassis rate [Hz]")->type_name("HZ")->check(CLI::PositiveNumber.description(""));
   app.add_option("--calibration", calibration_file, "chassis calibration YAML (default data/config/chassis_calibration.yaml)")
       ->type_name("FILE");
@@ -63,6 +67,7 @@ int main(int argc, char** argv) {
     udp::ServerSettings server_settings;
     server_settings.bind_address = bind;
     server_settings.port = port;
+    if (!key_file.empty()) server_settings.key = udp::Key::load(key_file);
     udp::UdpChassisServer server(server_settings);
 
     // The simulated car: AutoRally's single-track model on the track's start line.
@@ -107,20 +112,21 @@ int main(int argc, char** argv) {
         const Arbiter& a = chassis.arbiter();
         std::fprintf(stderr,
                      "t %6.1f s | steer %-9s %4.0f us | throttle %-9s %4.0f us | brake %4.0f us | "
-                     "%s | v %4.1f m/s | laps %d | rx %ld, rejected %ld\n",
+                     "%s | v %4.1f m/s | laps %d | rx %ld, rejected %ld (unauthenticated %ld)\n",
                      t, std::string(a.commander_name(out.decision.steering_commander)).c_str(),
                      pulses.steering_us,
                      std::string(a.commander_name(out.decision.throttle_commander)).c_str(),
                      pulses.throttle_us, pulses.front_brake_us,
                      out.decision.motion_enabled ? "motion enabled" : "RUNSTOP", s.vx_mps,
                      laps.laps_completed(), server.counters().received,
-                     server.counters().total_rejected());
+                     server.counters().total_rejected(), server.counters().unauthenticated());
       }
     });
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
-    std::fprintf(stderr, "mppi-udp-bridge: listening on %s:%d, chassis at %.0f Hz, %d controllers\n",
-                 bind.c_str(), server.port(), rate_hz, priorities.size());
+    std::fprintf(stderr, "mppi-udp-bridge: listening on %s:%d (%s), chassis at %.0f Hz, %d controllers\n",
+                 bind.c_str(), server.port(), server_settings.key ? "authenticated" : "no key: loopback only",
+                 rate_hz, priorities.size());
     std::thread timer([&] {  // --duration is wall-clock time
       const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration_s);
       while (duration_s > 0 && !g_stop && std::chrono::steady_clock::now() < end)
@@ -132,8 +138,9 @@ int main(int argc, char** argv) {
     timer.join();
 
     const auto& c = server.counters();
-    std::printf("datagrams received %ld: commands accepted %ld, runstops accepted %ld, rejected %ld\n",
-                c.received, c.commands_accepted, c.runstops_accepted, c.total_rejected());
+    std::printf("datagrams received %ld: commands accepted %ld, runstops accepted %ld, rejected %ld "
+                "(unauthenticated %ld)\n",
+                c.received, c.commands_accepted, c.runstops_accepted, c.total_rejected(), c.unauthenticated());
     for (int r = 1; r < udp::kRejectCount; ++r)
       if (c.rejected[static_cast<std::size_t>(r)])
         std::printf("  rejected, %s: %ld\n", udp::to_string(static_cast<udp::Reject>(r)),

@@ -2,13 +2,16 @@
 // network, or the kinematic bicycle) in the control-loop runner at a fixed rate on the state
 // datagrams of a chassis (mppi-udp-bridge, or any program speaking docs/CHASSIS.md), sends the
 // commands as controller `--name` and, as the operator station `--runstop-name`, a runstop
-// message allowing motion. On exit it prints the runner's deadline statistics.
+// message allowing motion. With --key FILE every datagram it sends is signed and only signed
+// ones are read (chassis state and parameter messages alike). On exit it prints the runner's
+// deadline statistics.
 #include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -29,6 +32,7 @@
 #include "sim/lap_counter.hpp"
 #include "sim/track.hpp"
 #ifdef MPPI_HAVE_OCS
+#include "apps/page_options.hpp"
 #include "ocs/loop_page.hpp"
 #include "sim/path_predictor.hpp"
 #endif
@@ -44,7 +48,7 @@ int main(int argc, char** argv) {
   using namespace mppi;
   using namespace mppi::chassis;
   std::string host = "127.0.0.1", name = "mppi", runstop_name = "OCS", model = models::AutoRallyNetworkModel::kName,
-              track_name = "gazebo";
+              track_name = "gazebo", key_file;
   int port = udp::kDefaultPort, param_port = udp::kDefaultParameterPort, serve_port = -1;
   double speed = 6.0, duration_s = 30.0;
   ControlLoopSettings loop_settings;
@@ -55,6 +59,9 @@ int main(int argc, char** argv) {
   cli::configure(app);
   app.add_option("--host", host, "chassis address")->type_name("ADDR");
   app.add_option("--port", port, "chassis UDP port")->type_name("N")->check(CLI::Range(0, 65535).description(""));
+  app.add_option("--key", key_file,
+                 "authenticate datagrams with this key file (64 hex digits, mode 600; required off loopback)")
+      ->type_name("FILE");
   app.add_option("--name", name, "controller name in the priorities")->type_name("NAME");
   app.add_option("--runstop-name", runstop_name, "runstop source name")->type_name("NAME");
   cli::add_model_option(app, "--model", model, "controller model (its default data file)");
@@ -73,9 +80,15 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 65535).description(""));
   std::string data_dir;
   cli::add_data_dir_option(app, data_dir);
-  app.add_option("--serve", serve_port, "operator page on http://127.0.0.1:PORT/ (docs/OCS.md)")
+  app.add_option("--serve", serve_port,
+                 "operator page on http://127.0.0.1:PORT/; open the URL it prints (with the page's token) "
+                 "(docs/OCS.md)")
       ->type_name("PORT")
       ->check(CLI::Range(0, 65535).description(""));
+#ifdef MPPI_HAVE_OCS
+  ocs::ServerSettings page_settings;
+  apps::add_page_options(app, page_settings.bind_address, page_settings.access);
+#endif
   if (const int rc = cli::parse(app, argc, argv); rc >= 0) return rc;
   try {
     const sim::Track track = sim::Track::load(track_name);
@@ -99,13 +112,18 @@ int main(int argc, char** argv) {
       loop_settings.state_size = D::Model::kNx;
       observe = [m](const float* common, float* model_x) { D::from_plant(m, common, state::kCommonStates, model_x); };
 #ifdef MPPI_HAVE_OCS
-      if (serve_port >= 0)
-        page = std::make_unique<ocs::LoopPage>(serve_port, track_name, sim::make_path_predictor(m, options.dt_s), speed);
+      if (serve_port >= 0) {
+        page_settings.port = serve_port;
+        page = std::make_unique<ocs::LoopPage>(page_settings, track_name, sim::make_path_predictor(m, options.dt_s),
+                                               speed);
+      }
 #endif
     });
 
-    udp::UdpChassisClient commands(name, host, port);
-    udp::UdpChassisClient runstop(runstop_name, host, port);
+    std::optional<udp::Key> key;
+    if (!key_file.empty()) key = udp::Key::load(key_file);
+    udp::UdpChassisClient commands(name, host, port, {}, key);
+    udp::UdpChassisClient runstop(runstop_name, host, port, {}, key);
     runstop.send_runstop(true);  // announce ourselves, so the chassis starts sending state
     commands.send_command(Command{});  // a neutral command: the chassis answers clients it heard
 
@@ -124,7 +142,7 @@ int main(int argc, char** argv) {
     updates.reserve(64);
     applying.reserve(64);
     std::unique_ptr<udp::UdpParameterListener> params;
-    if (param_port > 0) params = std::make_unique<udp::UdpParameterListener>("127.0.0.1", param_port);
+    if (param_port > 0) params = std::make_unique<udp::UdpParameterListener>("127.0.0.1", param_port, 64, key);
     std::thread param_receiver([&] {
       while (params && !stop_rx) {
         if (auto u = params->receive(0.05)) {

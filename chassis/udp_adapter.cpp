@@ -14,6 +14,11 @@
 
 namespace mppi::chassis::udp {
 
+long Counters::unauthenticated() const {
+  return rejected[static_cast<std::size_t>(Reject::kUnauthenticated)] +
+         rejected[static_cast<std::size_t>(Reject::kBadTag)];
+}
+
 long Counters::total_rejected() const {
   long n = 0;
   for (std::size_t i = 1; i < rejected.size(); ++i) n += rejected[i];
@@ -28,7 +33,7 @@ Reject PacketFilter::count(Reject r) {
 Reject PacketFilter::handle(std::span<const std::uint8_t> bytes, std::size_t datagram_size,
                             Arbiter& arbiter, Time now) {
   ++counters_.received;
-  const Message m = decode(bytes, datagram_size);
+  const Message m = decode_datagram(bytes, datagram_size, key_ ? &*key_ : nullptr);
   if (m.reason != Reject::kNone) return count(m.reason);
   if (m.type == MessageType::kState || m.type == MessageType::kParameter)
     return count(Reject::kBadType);  // vehicle -> stack, operator -> stack only
@@ -71,6 +76,19 @@ sockaddr_in make_address(const std::string& host, int port) {
 }
 bool same_address(const sockaddr_in& a, const sockaddr_in& b) {
   return a.sin_addr.s_addr == b.sin_addr.s_addr && a.sin_port == b.sin_port;
+}
+// The address, once require_key_off_loopback() let it pass (member initialisers: before binding).
+const std::string& checked(const std::string& what, const std::string& address, const std::optional<Key>& key) {
+  require_key_off_loopback(what, address, key ? &*key : nullptr);
+  return address;
+}
+// A stack end binds to loopback to talk to a chassis there, else to every address (the replies
+// come from the chassis' address).
+std::string local_address_for(const std::string& host) { return is_loopback_address(host) ? "127.0.0.1" : "0.0.0.0"; }
+std::uint64_t wall_clock_us() {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
+                                        std::chrono::system_clock::now().time_since_epoch())
+                                        .count());
 }
 }  // namespace
 
@@ -121,14 +139,14 @@ bool Socket::send_to(std::span<const std::uint8_t> bytes, const sockaddr_in& to)
 
 UdpChassisServer::UdpChassisServer(ServerSettings settings)
     : settings_(std::move(settings)),
-      socket_(settings_.bind_address, settings_.port),
-      filter_(settings_.max_senders),
+      socket_(checked("the chassis link's vehicle end", settings_.bind_address, settings_.key), settings_.port),
+      filter_(settings_.max_senders, settings_.key),
       state_sequence_(static_cast<std::uint64_t>(
           std::chrono::duration_cast<std::chrono::microseconds>(
               std::chrono::system_clock::now().time_since_epoch()).count())) {}
 
 int UdpChassisServer::poll(Arbiter& arbiter, Time now) {
-  std::array<std::uint8_t, kMaxMessageSize + 1> buffer;  // +1: a longer datagram shows as oversized
+  std::array<std::uint8_t, kMaxDatagramSize + 1> buffer;  // +1: a longer datagram shows as oversized
   int read = 0;
   for (; read < settings_.max_datagrams_per_poll; ++read) {
     sockaddr_in from{};
@@ -156,43 +174,44 @@ int UdpChassisServer::poll(Arbiter& arbiter, Time now) {
 }
 
 void UdpChassisServer::send_state(const StateMessage& state, Time now) {
-  const auto bytes = encode_state("chassis", ++state_sequence_, state);
+  const Datagram d = seal_datagram(encode_state("chassis", ++state_sequence_, state),
+                                   settings_.key ? &*settings_.key : nullptr);
   for (const auto& c : clients_)
-    if (now - c.last_heard < seconds(settings_.client_timeout_s)) socket_.send_to(bytes, c.address);
+    if (now - c.last_heard < seconds(settings_.client_timeout_s)) socket_.send_to(d.span(), c.address);
 }
 
 UdpChassisClient::UdpChassisClient(std::string sender, const std::string& host, int port,
-                                   std::optional<std::uint64_t> first_sequence)
+                                   std::optional<std::uint64_t> first_sequence, std::optional<Key> key)
     : sender_(std::move(sender)),
-      socket_(host == "127.0.0.1" ? "127.0.0.1" : "0.0.0.0", 0),
+      key_(std::move(key)),
+      socket_(local_address_for(checked("the chassis link to a vehicle", host, key_)), 0),
       server_(make_address(host, port)),
-      sequence_(first_sequence ? *first_sequence
-                               : static_cast<std::uint64_t>(
-                                     std::chrono::duration_cast<std::chrono::microseconds>(
-                                         std::chrono::system_clock::now().time_since_epoch())
-                                         .count())) {
+      sequence_(first_sequence ? *first_sequence : wall_clock_us()) {
   encode_runstop(sender_, 0, false);  // validates the sender name (throws mppi::Error)
 }
 
 void UdpChassisClient::send_command(const Command& command) {
-  socket_.send_to(encode_command(sender_, sequence_++, command), server_);
+  socket_.send_to(seal_datagram(encode_command(sender_, sequence_++, command), key_ ? &*key_ : nullptr).span(),
+                  server_);
 }
 
 void UdpChassisClient::send_runstop(bool motion_enabled) {
-  socket_.send_to(encode_runstop(sender_, sequence_++, motion_enabled), server_);
+  socket_.send_to(
+      seal_datagram(encode_runstop(sender_, sequence_++, motion_enabled), key_ ? &*key_ : nullptr).span(), server_);
 }
 
 void UdpChassisClient::send_raw(std::span<const std::uint8_t> bytes) { socket_.send_to(bytes, server_); }
 
 std::optional<StateMessage> UdpChassisClient::receive_state(double timeout_s) {
   const auto deadline = std::chrono::steady_clock::now() + seconds(timeout_s);
-  std::array<std::uint8_t, kMaxMessageSize + 1> buffer;
+  std::array<std::uint8_t, kMaxDatagramSize + 1> buffer;
   while (true) {
     sockaddr_in from{};
     const long n = socket_.receive(buffer, &from);
     if (n >= 0) {
       const std::size_t kept = std::min<std::size_t>(static_cast<std::size_t>(n), buffer.size());
-      const Message m = decode(std::span<const std::uint8_t>(buffer.data(), kept), static_cast<std::size_t>(n));
+      const Message m = decode_datagram(std::span<const std::uint8_t>(buffer.data(), kept),
+                                        static_cast<std::size_t>(n), key_ ? &*key_ : nullptr);
       if (m.reason == Reject::kNone && m.type == MessageType::kState &&
           (!have_state_ || m.sequence > last_state_sequence_)) {
         have_state_ = true;
@@ -207,18 +226,22 @@ std::optional<StateMessage> UdpChassisClient::receive_state(double timeout_s) {
   }
 }
 
-UdpParameterListener::UdpParameterListener(const std::string& bind_address, int port, std::size_t max_senders)
-    : socket_(bind_address, port), max_senders_(max_senders) {}
+UdpParameterListener::UdpParameterListener(const std::string& bind_address, int port, std::size_t max_senders,
+                                           std::optional<Key> key)
+    : key_(std::move(key)),
+      socket_(checked("the parameter listener", bind_address, key_), port),
+      max_senders_(max_senders) {}
 
 std::optional<ParameterUpdate> UdpParameterListener::receive(double timeout_s) {
   const auto deadline = std::chrono::steady_clock::now() + seconds(timeout_s);
-  std::array<std::uint8_t, kMaxMessageSize + 1> buffer;
+  std::array<std::uint8_t, kMaxDatagramSize + 1> buffer;
   while (true) {
     sockaddr_in from{};
     const long n = socket_.receive(buffer, &from);
     if (n >= 0) {
       const std::size_t kept = std::min<std::size_t>(static_cast<std::size_t>(n), buffer.size());
-      const Message m = decode(std::span<const std::uint8_t>(buffer.data(), kept), static_cast<std::size_t>(n));
+      const Message m = decode_datagram(std::span<const std::uint8_t>(buffer.data(), kept),
+                                        static_cast<std::size_t>(n), key_ ? &*key_ : nullptr);
       if (m.reason != Reject::kNone || m.type != MessageType::kParameter) {
         ++rejected_;
         continue;
@@ -239,18 +262,18 @@ std::optional<ParameterUpdate> UdpParameterListener::receive(double timeout_s) {
   }
 }
 
-UdpParameterSender::UdpParameterSender(std::string sender, const std::string& host, int port)
+UdpParameterSender::UdpParameterSender(std::string sender, const std::string& host, int port, std::optional<Key> key)
     : sender_(std::move(sender)),
-      socket_(host == "127.0.0.1" ? "127.0.0.1" : "0.0.0.0", 0),
+      key_(std::move(key)),
+      socket_(local_address_for(checked("parameter messages to a stack", host, key_)), 0),
       to_(make_address(host, port)),
-      sequence_(static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
-                                               std::chrono::system_clock::now().time_since_epoch())
-                                               .count())) {
+      sequence_(wall_clock_us()) {
   encode_runstop(sender_, 0, false);  // validates the sender name (throws mppi::Error)
 }
 
 void UdpParameterSender::send(std::string_view name, double value) {
-  socket_.send_to(encode_parameter(sender_, sequence_++, name, value), to_);
+  socket_.send_to(seal_datagram(encode_parameter(sender_, sequence_++, name, value), key_ ? &*key_ : nullptr).span(),
+                  to_);
 }
 
 }  // namespace mppi::chassis::udp

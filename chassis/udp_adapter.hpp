@@ -4,8 +4,10 @@
 // each chassis tick, hands well-formed, fresh, valid messages to the arbiter and counts every
 // rejected datagram by reason; rejected datagrams never reach the arbiter, so they cannot move
 // the car. It answers each client that sent an accepted message in the last second with state
-// messages. The stack end is UdpChassisClient. Loopback by default: there is no
-// authentication, the checksum only catches corruption, not forgery.
+// messages. The stack end is UdpChassisClient. Loopback by default. With a key (udp_auth.hpp)
+// every end signs what it sends and drops, and counts, datagrams without the right tag; off
+// loopback an end refuses to start without one (the checksum only catches corruption, not
+// forgery).
 #include <array>
 #include <chrono>
 #include <cstdint>
@@ -18,6 +20,7 @@
 #include <netinet/in.h>
 
 #include "chassis/arbiter.hpp"
+#include "chassis/udp_auth.hpp"
 #include "chassis/udp_protocol.hpp"
 
 namespace mppi::chassis::udp {
@@ -28,12 +31,16 @@ struct Counters {
   long runstops_accepted = 0;
   std::array<long, kRejectCount> rejected{};  // by Reject
   long total_rejected() const;
+  // Datagrams dropped for a missing or wrong authentication tag (of those in `rejected`).
+  long unauthenticated() const;
 };
 
-// The checks after decoding: message type, sender, replay, content; then the arbiter.
+// The checks: the tag (with a key), decoding, message type, sender, replay, content; then the
+// arbiter.
 class PacketFilter {
  public:
-  explicit PacketFilter(std::size_t max_senders = 64) : max_senders_(max_senders) {}
+  explicit PacketFilter(std::size_t max_senders = 64, std::optional<Key> key = {})
+      : max_senders_(max_senders), key_(std::move(key)) {}
   // One datagram of `datagram_size` bytes on the wire (bytes may hold fewer if truncated).
   Reject handle(std::span<const std::uint8_t> bytes, std::size_t datagram_size, Arbiter& arbiter,
                 Time now);
@@ -42,6 +49,7 @@ class PacketFilter {
  private:
   Reject count(Reject r);
   std::size_t max_senders_;
+  std::optional<Key> key_;
   std::vector<std::pair<std::string, std::uint64_t>> last_sequence_;
   Counters counters_;
 };
@@ -71,10 +79,12 @@ struct ServerSettings {
   std::size_t max_senders = 64;            // replay table size
   int max_datagrams_per_poll = 256;        // bound on work per chassis tick
   double client_timeout_s = 1.0;           // state goes to clients heard from this recently
+  std::optional<Key> key;                  // authenticate every datagram; required off loopback
 };
 
 class UdpChassisServer {
  public:
+  // Throws mppi::Error if the socket cannot be bound, or is bound off loopback without a key.
   explicit UdpChassisServer(ServerSettings settings = {});
   int port() const { return socket_.port(); }
   // Drains pending datagrams (never blocks) into the arbiter; returns how many were read.
@@ -99,12 +109,14 @@ class UdpChassisClient {
  public:
   // `sender` signs every message (controller name in the priorities, or runstop source).
   // The first sequence number defaults to the wall clock in microseconds, so a restarted
-  // client continues above its previous numbers.
+  // client continues above its previous numbers. With a key it signs its messages and accepts
+  // only state messages signed with it; a chassis off loopback needs one (throws mppi::Error).
   UdpChassisClient(std::string sender, const std::string& host = "127.0.0.1",
-                   int port = kDefaultPort, std::optional<std::uint64_t> first_sequence = {});
+                   int port = kDefaultPort, std::optional<std::uint64_t> first_sequence = {},
+                   std::optional<Key> key = {});
   void send_command(const Command& command);
   void send_runstop(bool motion_enabled);
-  // Sends raw bytes (tests of malformed datagrams).
+  // Sends raw bytes, unsigned (tests of malformed datagrams).
   void send_raw(std::span<const std::uint8_t> bytes);
   // The next valid state message within timeout_s, if any.
   std::optional<StateMessage> receive_state(double timeout_s);
@@ -113,6 +125,7 @@ class UdpChassisClient {
 
  private:
   std::string sender_;
+  std::optional<Key> key_;
   Socket socket_;
   sockaddr_in server_{};
   std::uint64_t sequence_;
@@ -131,17 +144,19 @@ struct ParameterUpdate {
 // The stack end of parameter messages (type 4): an operator station or script changes a cost
 // parameter of the running controller. Checks like the chassis server's: well-formed, a
 // parameter message, sequence rising per sender; the value itself is checked by whoever
-// applies it (Controller::set_cost_param names the key and range it refuses).
+// applies it (Controller::set_cost_param names the key and range it refuses). With a key, only
+// messages signed with it; off loopback it needs one (throws mppi::Error).
 class UdpParameterListener {
  public:
   UdpParameterListener(const std::string& bind_address = "127.0.0.1", int port = kDefaultParameterPort,
-                       std::size_t max_senders = 64);
+                       std::size_t max_senders = 64, std::optional<Key> key = {});
   int port() const { return socket_.port(); }
   // The next accepted parameter message within timeout_s, if any.
   std::optional<ParameterUpdate> receive(double timeout_s);
   long rejected() const { return rejected_; }
 
  private:
+  std::optional<Key> key_;
   Socket socket_;
   std::size_t max_senders_;
   std::vector<std::pair<std::string, std::uint64_t>> last_sequence_;
@@ -149,14 +164,17 @@ class UdpParameterListener {
 };
 
 // Sends parameter messages to a stack's UdpParameterListener. The first sequence number is the
-// wall clock in microseconds (a restarted sender continues above its previous numbers).
+// wall clock in microseconds (a restarted sender continues above its previous numbers). With a
+// key it signs them; a stack off loopback needs one (throws mppi::Error).
 class UdpParameterSender {
  public:
-  UdpParameterSender(std::string sender, const std::string& host = "127.0.0.1", int port = kDefaultParameterPort);
+  UdpParameterSender(std::string sender, const std::string& host = "127.0.0.1", int port = kDefaultParameterPort,
+                     std::optional<Key> key = {});
   void send(std::string_view name, double value);
 
  private:
   std::string sender_;
+  std::optional<Key> key_;
   Socket socket_;
   sockaddr_in to_{};
   std::uint64_t sequence_;

@@ -113,6 +113,8 @@ const char* to_string(Reject r) {
     case Reject::kTooManySenders: return "too many senders";
     case Reject::kRunstopRejected: return "runstop source rejected";
     case Reject::kBadParameterName: return "bad parameter name";
+    case Reject::kUnauthenticated: return "unauthenticated (no tag)";
+    case Reject::kBadTag: return "bad authentication tag";
   }
   return "unknown reason";
 }

@@ -61,8 +61,10 @@ enum class Reject : std::uint8_t {
   kTooManySenders,   // the sender table (replay state) is full
   kRunstopRejected,  // the arbiter refused the runstop source (too many sources)
   kBadParameterName, // empty, not NUL-padded, or not printable ASCII
+  kUnauthenticated,  // a message without an authentication tag, to an end with a key (udp_auth.hpp)
+  kBadTag,           // an authentication tag that is not the message's under this end's key
 };
-inline constexpr int kRejectCount = 17;
+inline constexpr int kRejectCount = 19;
 const char* to_string(Reject reason);
 
 struct StateMessage {

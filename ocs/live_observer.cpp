@@ -92,7 +92,13 @@ std::vector<chassis::PriorityEntry> LiveObserver::priorities() const {
   return priorities_;
 }
 
+std::optional<double> LiveObserver::target_speed_request() const {
+  const double v = last_target_speed_.load();
+  return v < 0.0 ? std::nullopt : std::optional<double>(v);
+}
+
 void LiveObserver::request_target_speed(double mps) {
+  last_target_speed_ = mps;
   const std::lock_guard<std::mutex> lock(request_mutex_);
   target_speed_request_ = mps;
 }

@@ -58,6 +58,8 @@ class LiveObserver final : public sim::StepObserver {
   bool paused() const { return paused_.load(); }
   bool finished() const { return finished_.load(); }
   bool motion_enabled_request() const { return motion_enabled_.load(); }
+  // The last target speed the page asked for (none before the first request).
+  std::optional<double> target_speed_request() const;
 
   TimingSplit timing() const;  // call after the run
 
@@ -66,6 +68,7 @@ class LiveObserver final : public sim::StepObserver {
   sim::PathPredictor predictor_;
   std::atomic<int> clients_{0};
   std::atomic<bool> paused_{false}, stop_{false}, finished_{false}, motion_enabled_{true};
+  std::atomic<double> last_target_speed_{-1.0};  // < 0: none requested
 
   // frames: back_ is the simulation thread's, shared_ is guarded by frame_mutex_
   LiveFrame back_, shared_;

@@ -9,18 +9,18 @@
 
 namespace mppi::ocs {
 
-LoopPage::LoopPage(int port, const std::string& track, sim::PathPredictor predictor, double target_speed_mps)
+LoopPage::LoopPage(ServerSettings server_settings, const std::string& track, sim::PathPredictor predictor,
+                   double target_speed_mps)
     : target_speed_mps_(target_speed_mps) {
   LiveSettings settings;
   settings.realtime = false;      // the control loop keeps its own clock
   settings.allow_pause = false;   // a vehicle cannot be paused: the runstop stops it
   live_ = std::make_unique<LiveObserver>(settings);
   live_->on_start(std::move(predictor));
-  ServerSettings s;
-  s.port = port;
-  server_ = std::make_unique<OcsServer>(s, live_.get(), track.empty() ? std::string() : track_json(track, false), "");
+  server_ = std::make_unique<OcsServer>(std::move(server_settings), live_.get(),
+                                        track.empty() ? std::string() : track_json(track, false), "");
   server_->start();
-  std::fprintf(stderr, "ocs: operator page on http://127.0.0.1:%d/\n", server_->port());
+  std::fprintf(stderr, "ocs: operator page on %s\n", server_->page_url().c_str());
 }
 
 LoopPage::~LoopPage() { server_->stop(); }

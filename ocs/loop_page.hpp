@@ -9,6 +9,7 @@
 #include <string>
 
 #include "mppi/vehicle_state.hpp"
+#include "ocs/server.hpp"
 #include "sim/step_observer.hpp"
 
 namespace mppi {
@@ -18,14 +19,12 @@ struct StepSummary;
 
 namespace mppi::ocs {
 
-class LiveObserver;
-class OcsServer;
-
 class LoopPage {
  public:
-  // Serves on 127.0.0.1:port; track: the built-in track to draw ("" = none). Throws mppi::Error
-  // if the port cannot be bound or the track is unknown.
-  LoopPage(int port, const std::string& track, sim::PathPredictor predictor, double target_speed_mps);
+  // Serves as `settings` say (127.0.0.1 by default) and prints the page's URL with its token;
+  // track: the built-in track to draw ("" = none). Throws mppi::Error if the port cannot be
+  // bound, the address needs TLS (OcsServer::start), or the track is unknown.
+  LoopPage(ServerSettings settings, const std::string& track, sim::PathPredictor predictor, double target_speed_mps);
   ~LoopPage();
 
   // Applies the operator's new target speed, if any, to the controller (between steps).

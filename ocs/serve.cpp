@@ -27,6 +27,7 @@ ServerSettings server_settings(const ServeOptions& o) {
   s.bind_address = o.bind_address;
   s.port = o.port;
   s.frame_rate_hz = o.frame_rate_hz;
+  s.access = o.access;
   return s;
 }
 
@@ -41,9 +42,9 @@ sim::RunSummary run_closed_loop_with_page(sim::ClosedLoopConfig config, const Se
   OcsServer server(server_settings(options), &live, track_json(config.track, config.clockwise), "");
   config.observer = &live;
   server.start();
-  if (!options.quiet)
-    std::fprintf(stderr, "ocs: operator page on http://%s:%d/ (%.0f frames/s%s)\n", options.bind_address.c_str(),
-                 server.port(), options.frame_rate_hz, options.realtime ? ", real time" : "");
+  // Always printed (also when quiet): the page can change nothing without the token in this URL.
+  std::fprintf(stderr, "ocs: operator page on %s (%.0f frames/s%s)\n", server.page_url().c_str(),
+               options.frame_rate_hz, options.realtime ? ", real time" : "");
   g_interrupted = false;
   auto previous_int = std::signal(SIGINT, on_signal);
   auto previous_term = std::signal(SIGTERM, on_signal);
@@ -108,10 +109,8 @@ int serve_recording(const std::string& csv_path, std::string track, const ServeO
   OcsServer server(server_settings(options), nullptr, track.empty() ? std::string() : track_json(track, false),
                    recording_json(recording, csv_path));
   server.start();
-  if (!options.quiet)
-    std::fprintf(stderr, "ocs: replay of %s (%zu rows%s%s) on http://%s:%d/ - Ctrl-C to stop\n", csv_path.c_str(),
-                 recording.rows(), track.empty() ? "" : ", track ", track.c_str(), options.bind_address.c_str(),
-                 server.port());
+  std::fprintf(stderr, "ocs: replay of %s (%zu rows%s%s) on %s - Ctrl-C to stop\n", csv_path.c_str(),
+               recording.rows(), track.empty() ? "" : ", track ", track.c_str(), server.page_url().c_str());
   g_interrupted = false;
   auto previous_int = std::signal(SIGINT, on_signal);
   auto previous_term = std::signal(SIGTERM, on_signal);

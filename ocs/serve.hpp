@@ -4,6 +4,7 @@
 // (replay); Ctrl-C ends a live run cleanly (its logs are written).
 #include <string>
 
+#include "ocs/page_access.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/summary.hpp"
 
@@ -15,6 +16,7 @@ struct ServeOptions {
   double frame_rate_hz = 20.0;
   bool realtime = true;  // live: hold the simulation to wall-clock time
   bool quiet = false;
+  PageAccess access;      // TLS, remote use, the token (docs/SECURITY.md)
 };
 
 // Optimizer time percentiles of a live run, split by whether a page was connected.

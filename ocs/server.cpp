@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "base/error.hpp"
@@ -30,6 +31,34 @@ bool parse_flag(const std::string& name, const std::string& text, bool* value, s
   return false;
 }
 
+std::optional<std::string> header(const httplib::Request& req, const char* name) {
+  if (!req.has_header(name)) return std::nullopt;
+  return req.get_header_value(name);
+}
+
+std::unique_ptr<httplib::Server> make_http_server(const ServerSettings& s) {
+  const PageAccess& a = s.access;
+  if (a.tls_cert_file.empty() != a.tls_key_file.empty())
+    throw Error("ocs server: TLS needs both a certificate and a key file (--serve-cert and --serve-key)");
+  if (a.tls_cert_file.empty()) {
+    if (!is_loopback_bind(s.bind_address) && !a.insecure_remote)
+      throw Error("ocs server: refusing to serve the operator page on " + s.bind_address +
+                  " (off loopback) over plain HTTP: anyone on the network path could read the token and drive "
+                  "the car. Give --serve-cert FILE --serve-key FILE for HTTPS, or --serve-insecure-remote to "
+                  "accept that risk (docs/SECURITY.md)");
+    return std::make_unique<httplib::Server>();
+  }
+#ifdef CPPHTTPLIB_OPENSSL_SUPPORT
+  auto tls = std::make_unique<httplib::SSLServer>(a.tls_cert_file.c_str(), a.tls_key_file.c_str());
+  if (!tls->is_valid())
+    throw Error("ocs server: cannot use the TLS certificate " + a.tls_cert_file + " with the key " +
+                a.tls_key_file + " (missing, unreadable, not PEM, or not a pair)");
+  return tls;
+#else
+  throw Error("ocs server: this build's cpp-httplib has no OpenSSL support, so no HTTPS (Debian's libcpp-httplib-dev has)");
+#endif
+}
+
 // The page comes after the controller: every thread of the server runs under SCHED_IDLE, so it
 // only gets a core the controller's threads leave idle (Linux; elsewhere nothing changes).
 void yield_to_controller() {
@@ -47,9 +76,10 @@ void yield_to_controller() {
 
 OcsServer::OcsServer(ServerSettings settings, LiveObserver* live, std::string track_json, std::string recording_json)
     : settings_(std::move(settings)), live_(live), track_json_(std::move(track_json)),
-      recording_json_(std::move(recording_json)), http_(std::make_unique<httplib::Server>()) {
+      recording_json_(std::move(recording_json)) {
   if (!(settings_.frame_rate_hz > 0.0 && settings_.frame_rate_hz <= 60.0))
     throw Error("ocs server: frame rate must be in (0, 60] Hz");
+  http_ = make_http_server(settings_);
   add_routes();
 }
 
@@ -64,11 +94,31 @@ void OcsServer::start() {
   if (port_ <= 0)
     throw Error("ocs server: cannot listen on " + settings_.bind_address + ":" + std::to_string(settings_.port) +
                 " (in use, or not an address of this machine)");
+  const bool tls = !settings_.access.tls_cert_file.empty();
+  rules_.token = settings_.access.token.empty() ? make_token() : settings_.access.token;
+  rules_.hosts = page_hosts(settings_.bind_address, port_, tls, settings_.access.extra_hosts);
+  rules_.tls = tls;
   listener_ = std::thread([this] {
     yield_to_controller();
     http_->listen_after_bind();
   });
+  // Until the listener runs, httplib's stop() does nothing: a stop() right after start() would
+  // leave the listener running and the join in stop() waiting forever.
+  for (int i = 0; i < 5000 && !http_->is_running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   if (live_) publisher_ = std::thread([this] { publish_loop(); });
+}
+
+std::string OcsServer::page_url() const {
+  std::string host = rules_.hosts.empty() ? "127.0.0.1:" + std::to_string(port_) : rules_.hosts.front();
+  return (rules_.tls ? "https://" : "http://") + host + "/?token=" + rules_.token;
+}
+
+// Every refusal is logged until there were 20, then one in 100 (a page retrying in a loop, or a
+// flood, does not fill the log).
+void OcsServer::log_refusal(const std::string& request, const std::string& why) {
+  const long n = ++refused_;
+  if (n <= 20 || n % 100 == 0)
+    std::fprintf(stderr, "ocs: refused %s (403, %ld refused so far): %s\n", request.c_str(), n, why.c_str());
 }
 
 void OcsServer::stop() {
@@ -112,9 +162,20 @@ void OcsServer::publish_loop() {
 
 void OcsServer::add_routes() {
   httplib::Server& s = *http_;
-  s.set_pre_routing_handler([](const httplib::Request&, httplib::Response&) {
+  // The token is in the page's address: no Referer carries it away, no other site frames the page.
+  s.set_default_headers({{"Referrer-Policy", "no-referrer"},
+                         {"X-Frame-Options", "DENY"},
+                         {"X-Content-Type-Options", "nosniff"}});
+  // Before any route: the request must come through this page's own host and origin, and carry
+  // the token if it would change anything (page_access.hpp).
+  s.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     yield_to_controller();  // the worker thread that handles this request
-    return httplib::Server::HandlerResponse::Unhandled;
+    const std::string why = refusal(rules_, req.get_header_value("Host"), header(req, "Origin"),
+                                    header(req, kTokenHeader), req.method != "GET" && req.method != "HEAD");
+    if (why.empty()) return httplib::Server::HandlerResponse::Unhandled;
+    log_refusal(req.method + " " + req.path + " from " + req.remote_addr, why);
+    reply_error(res, 403, why);
+    return httplib::Server::HandlerResponse::Handled;
   });
   s.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
     std::string what = "internal error";
@@ -144,7 +205,12 @@ void OcsServer::add_routes() {
                                  {"paused", live_ && live_->paused()},
                                  {"can_pause", live_ && live_->pause_allowed()},
                                  {"finished", live_ && live_->finished()},
-                                 {"clients", live_ ? live_->clients() : 0}};
+                                 {"clients", live_ ? live_->clients() : 0},
+                                 {"motion_enabled", !live_ || live_->motion_enabled_request()},
+                                 {"target_speed_mps", live_ && live_->target_speed_request()
+                                                          ? nlohmann::json(*live_->target_speed_request())
+                                                          : nlohmann::json(nullptr)},
+                                 {"refused_requests", refused_.load()}};
     res.set_content(info.dump(), "application/json");
   });
   s.Get("/api/track", [this](const httplib::Request&, httplib::Response& res) {

@@ -2,7 +2,8 @@
 // The operator page's web server (cpp-httplib): the page and its scripts, the track, and
 // either a live simulation (frames as server-sent events at a bounded rate, controls) or a
 // recording to replay. It runs on its own threads; the simulation only ever meets it through
-// LiveObserver's non-blocking mailbox. Endpoints are listed in docs/OCS.md.
+// LiveObserver's non-blocking mailbox. Endpoints are listed in docs/OCS.md; who may use them
+// (page_access.hpp) in docs/SECURITY.md.
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
@@ -12,6 +13,7 @@
 #include <thread>
 
 #include "ocs/live_observer.hpp"
+#include "ocs/page_access.hpp"
 
 namespace httplib {
 class Server;
@@ -24,6 +26,7 @@ struct ServerSettings {
   int port = 8080;                         // 0 = any free port
   double frame_rate_hz = 20.0;             // frames sent to a page per second, at most
   int max_streams = 4;                     // pages streaming at once; more get 503
+  PageAccess access;                       // TLS, remote use, the token
 };
 
 class OcsServer {
@@ -35,14 +38,19 @@ class OcsServer {
   OcsServer(const OcsServer&) = delete;
   OcsServer& operator=(const OcsServer&) = delete;
 
-  // Binds and starts serving; throws mppi::Error if the address or port cannot be bound.
+  // Binds and starts serving; throws mppi::Error if the address or port cannot be bound, or if
+  // it is off loopback with neither TLS nor access.insecure_remote.
   void start();
   void stop();
   int port() const { return port_; }
+  // The page's address with its token (after start()): the one URL whose page can change state.
+  std::string page_url() const;
+  long refused_requests() const { return refused_.load(); }
 
  private:
   void add_routes();
   void publish_loop();
+  void log_refusal(const std::string& request, const std::string& why);
 
   ServerSettings settings_;
   LiveObserver* live_;
@@ -50,6 +58,8 @@ class OcsServer {
   std::unique_ptr<httplib::Server> http_;
   std::thread listener_, publisher_;
   int port_ = 0;
+  AccessRules rules_;  // set in start(), before the first request
+  std::atomic<long> refused_{0};
   std::atomic<int> streams_{0};
 
   std::mutex latest_mutex_;

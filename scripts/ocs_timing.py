@@ -12,10 +12,12 @@ OUT/ocs_timing.json (p50, p99 and the with/without ratios), printed at the end.
 import argparse
 import json
 import os
+import re
 import shutil
 import socket
 import subprocess
 import sys
+import threading
 import time
 import urllib.request
 
@@ -40,7 +42,9 @@ def main():
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
     sim = subprocess.Popen([os.path.join(a.bin, "mppi-sim"), "--serve", str(port), "--laps", "100000",
-                            "--max-time", str(a.seconds * 10), "--out", a.out, "--quiet", *a.sim_args])
+                            "--max-time", str(a.seconds * 10), "--out", a.out, "--quiet", *a.sim_args],
+                           stderr=subprocess.PIPE, text=True)
+    token = page_token(sim)
     url = f"http://127.0.0.1:{port}"
     for _ in range(300):
         try:
@@ -51,10 +55,26 @@ def main():
     if a.client == "stream":
         stream_cycles(port, a.seconds, a.cycle)
     else:
-        browse(chromium, url, a.seconds, a.cycle, a.browser_idle)
-    urllib.request.urlopen(urllib.request.Request(url + "/api/control", data=b"stop=1"), timeout=10)
+        browse(chromium, f"{url}/?token={token}", a.seconds, a.cycle, a.browser_idle)
+    urllib.request.urlopen(urllib.request.Request(url + "/api/control", data=b"stop=1",
+                                                  headers={"X-MPPI-Token": token}), timeout=10)
     sim.wait(timeout=120)
     print(json.dumps(json.load(open(os.path.join(a.out, "ocs_timing.json"))), indent=2))
+
+
+def page_token(sim):
+    """The page's token, from the URL mppi-sim prints; its stderr is then passed on to ours."""
+    token = None
+    for line in sim.stderr:
+        sys.stderr.write(line)
+        m = re.search(r"/\?token=([0-9a-f]+)", line)
+        if m:
+            token = m.group(1)
+            break
+    threading.Thread(target=lambda: [sys.stderr.write(l) for l in sim.stderr], daemon=True).start()
+    if not token:
+        sys.exit("ocs_timing: mppi-sim printed no page URL")
+    return token
 
 
 def stream_cycles(port, seconds, cycle):
@@ -62,7 +82,7 @@ def stream_cycles(port, seconds, cycle):
     end = time.time() + seconds
     while time.time() < end:
         with socket.create_connection(("127.0.0.1", port), timeout=5) as s:
-            s.sendall(b"GET /api/stream HTTP/1.1\r\nHost: x\r\n\r\n")
+            s.sendall(f"GET /api/stream HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n".encode())
             until = time.time() + cycle
             while time.time() < until:
                 try:
@@ -78,7 +98,7 @@ def browse(chromium, url, seconds, cycle, idle):
     prefix = ["chrt", "--idle", "0"] if idle else []
     browser = subprocess.Popen([*prefix, chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
                                 "--window-size=1400,1150", "--remote-debugging-port=0",
-                                f"{url}/?cycle={cycle}"], env=env, stdout=subprocess.DEVNULL,
+                                f"{url}&cycle={cycle}"], env=env, stdout=subprocess.DEVNULL,
                                stderr=subprocess.DEVNULL)
     time.sleep(seconds)
     browser.terminate()

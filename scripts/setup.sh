@@ -11,7 +11,7 @@ MPPI_DEBIAN_PACKAGES=(
   python3-distributed python3-optuna python3-pandas python3-sqlalchemy
   mesa-vulkan-drivers libvulkan-dev glslang-tools spirv-tools
   libplplot-dev plplot-driver-cairo fonts-dejavu-core libcmark-gfm-dev libcmark-gfm-extensions-dev
-  libcpp-httplib-dev nodejs npm chromium
+  libcpp-httplib-dev libssl-dev nodejs npm chromium
 )
 
 mppi_missing_packages() {

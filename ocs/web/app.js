@@ -5,7 +5,11 @@
 
 const CHART_SECONDS = 30;
 const TRAIL_POINTS = 4000;
-const testMode = new URLSearchParams(location.search).has('test');
+const query = new URLSearchParams(location.search);
+const testMode = query.has('test');
+// The server's per-launch secret, from the URL it printed (?token=...): without it the page
+// shows everything but can change nothing (docs/SECURITY.md).
+const token = query.get('token') || '';
 // ?frames=N: stop streaming after N frames (the browser test: 15)
 const holdAfter = +(new URLSearchParams(location.search).get('frames') || (testMode ? 15 : 0));
 const $ = (id) => document.getElementById(id);
@@ -241,11 +245,15 @@ function showStatus(f) {
 
 // ---- live mode ----
 let frames = 0, lastFrame = null, chartsDrawnAt = 0;
+const controlReplies = [];  // {status, error} of each control sent (the browser test reads them)
+let controlsPending = 0;
+const whenControlsDone = (f) => (controlsPending ? setTimeout(() => whenControlsDone(f), 20) : f());
 
 function startLive(info) {
   $('mode').textContent = info.can_pause ? 'live simulation' : 'live vehicle';
   $('pause').hidden = !info.can_pause;
   $('st-priorities').textContent = info.priorities.map((p) => `${p.sender} (${p.priority})`).join(', ') || '–';
+  if (!token) $('control-error').textContent = 'view only: open the URL the server printed (with ?token=...) to use the controls';
   let source = new EventSource('/api/stream');
   const cycle = +new URLSearchParams(location.search).get('cycle');
   if (cycle > 0)  // the timing measurement: connected for `cycle` seconds, then not, and so on
@@ -274,17 +282,35 @@ function startLive(info) {
     }
     drawScene(f);
     showStatus(f);
+    // ?press=ID[,ID]: the browser test presses these buttons once (with ?target=V for set-target)
+    if (testMode && frames === 1 && query.get('press')) {
+      if (query.has('target')) $('target').value = query.get('target');
+      for (const id of query.get('press').split(',')) $(id).click();
+    }
     if (frames === holdAfter) {  // a screenshot or the browser test: hold the picture still
       source.close();
-      if (testMode) report({ mode: 'live', frames, t: f.t, rollouts_in_frame: f.rollouts.length });
+      if (testMode) {
+        const extra = { mode: 'live', frames, t: f.t, rollouts_in_frame: f.rollouts.length };
+        whenControlsDone(() => report({ ...extra, controls: controlReplies }));
+      }
     }
   };
   source.onmessage = onFrame;
   source.onerror = () => { $('mode').textContent = 'live simulation (disconnected)'; };
   const post = async (params) => {
-    const r = await fetch('/api/control', { method: 'POST', body: new URLSearchParams(params) });
-    const body = await r.json();
-    $('control-error').textContent = r.ok ? '' : body.error;
+    ++controlsPending;
+    try {
+      const r = await fetch('/api/control', { method: 'POST', body: new URLSearchParams(params),
+                                              headers: { 'X-MPPI-Token': token } });
+      const body = await r.json();
+      controlReplies.push({ status: r.status, error: body.error || '' });
+      $('control-error').textContent = r.ok ? '' : body.error;
+    } catch (e) {
+      controlReplies.push({ status: 0, error: String(e) });
+      $('control-error').textContent = `control not sent: ${e}`;
+    } finally {
+      --controlsPending;
+    }
   };
   $('pause').onclick = () => post({ pause: lastFrame && lastFrame.paused ? '0' : '1' });
   $('runstop').onclick = () => post({ runstop: lastFrame && lastFrame.chassis.present && !lastFrame.chassis.motion_enabled ? '0' : '1' });

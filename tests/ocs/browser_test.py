@@ -30,7 +30,10 @@ import urllib.error
 import urllib.request
 import zlib
 
+from page_launch import Page
+
 SAMPLES = "512"
+TOKENS = {}  # port -> the page's token, read from the URL the server printed
 
 
 def fail(msg):
@@ -54,7 +57,8 @@ def free_port():
 
 
 def http(port, path, data=None, timeout=10):
-    req = urllib.request.Request(f"http://127.0.0.1:{port}{path}", data=data)
+    req = urllib.request.Request(f"http://127.0.0.1:{port}{path}", data=data,
+                                 headers={"X-MPPI-Token": TOKENS.get(port, "")})
     try:
         with urllib.request.urlopen(req, timeout=timeout) as r:
             return r.status, r.read()
@@ -85,7 +89,7 @@ def raw(port, payload, read=True):
 def stream_events(port, count, timeout=20):
     """Opens /api/stream, reads `count` events and disconnects mid-stream."""
     s = socket.create_connection(("127.0.0.1", port), timeout=timeout)
-    s.sendall(b"GET /api/stream HTTP/1.1\r\nHost: x\r\n\r\n")
+    s.sendall(f"GET /api/stream HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n".encode())
     buf, events = b"", []
     end = time.time() + timeout
     while len(events) < count and time.time() < end:
@@ -202,8 +206,10 @@ def main():
     # ---- 1. live ----
     port = free_port()
     live_dir = os.path.join(work, "live")
-    proc = subprocess.Popen([sim, "--serve", str(port), "--max-time", "120", "--laps", "1000", "--samples", SAMPLES,
-                             "--out", live_dir, "--quiet"], stderr=subprocess.PIPE, text=True)
+    page = Page([sim, "--serve", str(port), "--max-time", "120", "--laps", "1000", "--samples", SAMPLES,
+                 "--out", live_dir, "--quiet"])
+    proc = page.proc
+    TOKENS[port] = page.token
     try:
         wait_ready(port, proc)
         info = json.loads(http(port, "/api/info")[1])
@@ -232,10 +238,10 @@ def main():
         holders = []
         for _ in range(4):
             s = socket.create_connection(("127.0.0.1", port), timeout=5)
-            s.sendall(b"GET /api/stream HTTP/1.1\r\nHost: x\r\n\r\n")
+            s.sendall(f"GET /api/stream HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n".encode())
             holders.append(s)
         wait_clients(lambda n: n >= 4)
-        fifth = raw(port, b"GET /api/stream HTTP/1.1\r\nHost: x\r\n\r\n")
+        fifth = raw(port, f"GET /api/stream HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n".encode())
         check(fifth.startswith(b"HTTP/1.1 503"), "a fifth stream: 503")
         for s in holders:
             s.close()
@@ -248,7 +254,7 @@ def main():
         after = stream_events(port, 2)
         check(len(after) == 2 and after[1]["t"] > after[0]["t"], "running again after pause")
 
-        report, pixels = browser_report(chromium, f"http://127.0.0.1:{port}/?test=1",
+        report, pixels = browser_report(chromium, f"{page.url}&test=1",
                                         os.path.join(out_dir, "ocs_live_canvas.png"))
         print(f"canvas PNG decoded here: {pixels}", flush=True)
         check(report["mode"] == "live" and report["frames"] >= 15, "the page got 15 frames")
@@ -268,7 +274,6 @@ def main():
         if proc.poll() is None:
             proc.send_signal(signal.SIGTERM)
             proc.wait(timeout=30)
-    err = proc.stderr.read()
     check(os.path.exists(os.path.join(live_dir, "ocs_timing.json")), "timing split written")
     print(json.load(open(os.path.join(live_dir, "ocs_timing.json"))), flush=True)
 
@@ -296,13 +301,14 @@ def main():
                    check=False, timeout=300)
     check(os.path.exists(os.path.join(replay_dir, "log.csv")), "a recording to replay")
     port2 = free_port()
-    replay = subprocess.Popen([sim, "--replay", os.path.join(replay_dir, "log.csv"), "--serve", str(port2)],
-                              stderr=subprocess.PIPE, text=True)
+    replay_page = Page([sim, "--replay", os.path.join(replay_dir, "log.csv"), "--serve", str(port2)])
+    replay = replay_page.proc
+    TOKENS[port2] = replay_page.token
     try:
         wait_ready(port2, replay)
         check(json.loads(http(port2, "/api/info")[1])["mode"] == "replay", "replay mode")
         check(http(port2, "/api/control", data=b"pause=1")[0] == 404, "a replay has no controls: 404")
-        report, pixels = browser_report(chromium, f"http://127.0.0.1:{port2}/?test=1",
+        report, pixels = browser_report(chromium, f"{replay_page.url}&test=1",
                                         os.path.join(out_dir, "ocs_replay_canvas.png"))
         print(f"canvas PNG decoded here: {pixels}", flush=True)
         check(report["mode"] == "replay", "the page replays")
@@ -317,7 +323,6 @@ def main():
             fail("the replay server did not stop on SIGTERM")
     check(replay.returncode == 0, "replay server stopped cleanly")
     shutil.rmtree(work, ignore_errors=True)
-    del err
     print(f"PASS ({time.time() - started:.0f} s)")
 
 

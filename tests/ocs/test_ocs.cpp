@@ -186,9 +186,12 @@ TEST_CASE("the server answers good and bad requests and a replay has no controls
   mppi::ocs::LiveObserver live;
   mppi::ocs::ServerSettings s;
   s.port = 0;
+  s.access.token = "secret";  // given, not drawn: the page's controls send it back
   mppi::ocs::OcsServer server(s, &live, "", "");
   server.start();
+  CHECK(server.page_url() == "http://127.0.0.1:" + std::to_string(server.port()) + "/?token=secret");
   httplib::Client client("127.0.0.1", server.port());
+  client.set_default_headers({{"X-MPPI-Token", "secret"}});
   auto info = client.Get("/api/info");
   REQUIRE(info);
   CHECK(info->status == 200);
@@ -212,6 +215,7 @@ TEST_CASE("the server answers good and bad requests and a replay has no controls
   mppi::ocs::OcsServer replay(s, nullptr, "", "{\"rows\": 0}");
   replay.start();
   httplib::Client rc("127.0.0.1", replay.port());
+  rc.set_default_headers({{"X-MPPI-Token", "secret"}});
   CHECK(rc.Get("/api/recording")->body == "{\"rows\": 0}");
   CHECK(rc.Post("/api/control", "pause=1", "application/x-www-form-urlencoded")->status == 404);
   CHECK(rc.Get("/api/stream")->status == 404);
