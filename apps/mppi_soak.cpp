@@ -17,6 +17,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <memory>
+#include <array>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -27,6 +29,7 @@
 #include "chassis/chassis.hpp"
 #include "chassis/control_loop.hpp"
 #include "chassis/udp_adapter.hpp"
+#include "chassis/udp_auth.hpp"
 #include "costs/autorally_cost.hpp"
 #include "costs/cost_config.hpp"
 #include "dynamics/models/single_track_model.hpp"
@@ -52,6 +55,9 @@ constexpr const char* kUsage = R"(usage: mppi-soak [options]
   --speed MPS            target speed                                   (6)
   --malformed-per-second N  malformed datagrams per simulated second    (20)
   --rss-growth-kib N     largest allowed RSS growth after warm-up       (2048)
+  --authenticate         sign every datagram with a per-run random key (HMAC-SHA256,
+                         docs/CHASSIS.md); the malformed traffic then also sends unsigned
+                         and wrongly signed commands
   --out FILE             also write the JSON report to FILE
 )";
 
@@ -92,24 +98,33 @@ struct Settings {
   double speed_mps = 6.0;
   double malformed_per_second = 20.0;
   long rss_growth_limit_kib = 2048;
+  bool authenticate = false;
   std::string out;
   mppi::ControllerOptions controller;
 };
 
 // Sends malformed datagrams of every kind in turn, each from a sender whose valid messages
-// would be accepted, so only the malformation can be the reason for a rejection.
+// would be accepted, so only the malformation can be the reason for a rejection. With a key,
+// every malformed message is signed with it (so it reaches the checks behind the tag), and two
+// more kinds test the tag itself: a valid command unsigned, and one signed with another key.
 class MalformedTraffic {
  public:
   // `replayed` is the sender whose old sequence numbers are replayed (its messages were accepted).
-  MalformedTraffic(int port, std::uint64_t seed, const mppi::chassis::udp::UdpChassisClient& replayed)
-      : raw_("fuzz", "127.0.0.1", port), rng_(seed), replayed_(replayed) {}
+  MalformedTraffic(int port, std::uint64_t seed, const mppi::chassis::udp::UdpChassisClient& replayed,
+                   const std::optional<mppi::chassis::udp::Key>& key)
+      : raw_("fuzz", "127.0.0.1", port), rng_(seed), replayed_(replayed), key_(key) {
+    std::array<std::uint8_t, mppi::chassis::udp::kKeySize> other{};
+    for (auto& b : other) b = static_cast<std::uint8_t>(rng_());
+    other_key_ = other;
+  }
   void send_one() {
     using namespace mppi::chassis;
     std::uniform_real_distribution<float> value(-1.f, 1.f);
     const Command valid{value(rng_), value(rng_), 0.f, actuator::kAll};
     const auto good = udp::encode_command("backup", ++sequence_, valid);
     std::vector<std::uint8_t> bytes;
-    switch (kind_++ % 6) {
+    bool sign = key_.has_value();
+    switch (kind_++ % (key_ ? 8 : 6)) {
       case 0: {  // random bytes of a random length
         bytes.resize(std::uniform_int_distribution<int>(0, 120)(rng_));
         for (auto& b : bytes) b = static_cast<std::uint8_t>(rng_());
@@ -135,13 +150,29 @@ class MalformedTraffic {
         bytes[std::uniform_int_distribution<std::size_t>(0, bytes.size() - 1)(rng_)] ^=
             static_cast<std::uint8_t>(1u << (rng_() % 8));
         break;
-      default: {  // a replay: the operator's "motion allowed" under an old sequence number
+      case 5: {  // a replay: the operator's "motion allowed" under an old sequence number
         const auto b = udp::encode_runstop("OCS", replayed_.next_sequence() - 2, true);
         bytes.assign(b.begin(), b.end());
         break;
       }
+      case 6:  // a valid command without its tag
+        bytes.assign(good.begin(), good.end());
+        sign = false;
+        break;
+      default: {  // a valid command signed with another key
+        const auto tag = udp::hmac_sha256(other_key_, good);
+        bytes.assign(good.begin(), good.end());
+        bytes.insert(bytes.end(), tag.begin(), tag.end());
+        sign = false;
+        break;
+      }
     }
-    raw_.send_raw(bytes);
+    if (sign) {
+      const udp::Datagram d = udp::seal_datagram(bytes, &*key_);
+      raw_.send_raw(d.span());
+    } else {
+      raw_.send_raw(bytes);
+    }
     ++sent_;
   }
   long sent() const { return sent_; }
@@ -150,10 +181,25 @@ class MalformedTraffic {
   mppi::chassis::udp::UdpChassisClient raw_;
   std::mt19937_64 rng_;
   const mppi::chassis::udp::UdpChassisClient& replayed_;
+  std::optional<mppi::chassis::udp::Key> key_;
+  std::array<std::uint8_t, mppi::chassis::udp::kKeySize> other_key_{};
   std::uint64_t sequence_ = 1;  // the "backup" controller's sequence numbers
   unsigned kind_ = 0;
   long sent_ = 0;
 };
+
+// A random key for one run (std::random_device).
+mppi::chassis::udp::Key random_key() {
+  std::random_device rd;
+  static const char* kHex = "0123456789abcdef";
+  std::string hex;
+  for (std::size_t i = 0; i < mppi::chassis::udp::kKeySize; ++i) {
+    const unsigned b = rd() & 0xffu;
+    hex += kHex[b >> 4];
+    hex += kHex[b & 15u];
+  }
+  return mppi::chassis::udp::Key::from_hex(hex, "the soak's random key");
+}
 
 int run(const Settings& s) {
   using namespace mppi;
@@ -196,12 +242,15 @@ int run(const Settings& s) {
   chassis_loop.add_command_input("mppi", mailbox);
   udp::ServerSettings server_settings;
   server_settings.port = 0;  // any free loopback port
+  std::optional<udp::Key> key;
+  if (s.authenticate) key = random_key();
+  server_settings.key = key;
   udp::UdpChassisServer server(server_settings);
   chassis_loop.add_input([&server](Arbiter& arbiter, Time now) { server.poll(arbiter, now); });
   ChassisOutput output;
   chassis_loop.set_sink([&output](const ChassisOutput& o) { output = o; });
-  udp::UdpChassisClient operator_station("OCS", "127.0.0.1", server.port());
-  MalformedTraffic malformed(server.port(), s.controller.seed, operator_station);
+  udp::UdpChassisClient operator_station("OCS", "127.0.0.1", server.port(), {}, key);
+  MalformedTraffic malformed(server.port(), s.controller.seed, operator_station, key);
 
   // The control-loop runner, one tick per controller period, on its own fake clock.
   std::vector<float> model_x(D::Model::kNx);
@@ -345,7 +394,8 @@ int run(const Settings& s) {
   nlohmann::ordered_json rejected;
   for (int r = 1; r < udp::kRejectCount; ++r)
     if (udp.rejected[r]) rejected[udp::to_string(static_cast<udp::Reject>(r))] = udp.rejected[r];
-  j["udp"] = {{"runstops_sent", runstops_sent},         {"runstops_accepted", udp.runstops_accepted},
+  j["udp"] = {{"authenticated", s.authenticate},
+              {"runstops_sent", runstops_sent},         {"runstops_accepted", udp.runstops_accepted},
               {"malformed_sent", malformed.sent()},      {"received", udp.received},
               {"rejected", udp.total_rejected()},        {"malformed_accepted", udp_wrongly_accepted},
               {"rejected_by_reason", rejected}};
@@ -361,6 +411,9 @@ int run(const Settings& s) {
   if (out_of_limits) failed.push_back("a command outside the actuator limits");
   if (runstop_violations) failed.push_back("throttle while the operator's runstop said stop");
   if (udp_wrongly_accepted) failed.push_back("a malformed datagram was accepted");
+  if (s.authenticate && (udp.rejected[static_cast<int>(udp::Reject::kUnauthenticated)] == 0 ||
+                         udp.rejected[static_cast<int>(udp::Reject::kBadTag)] == 0))
+    failed.push_back("unsigned or wrongly signed datagrams were not rejected by their tag");
   if (udp.runstops_accepted != runstops_sent) failed.push_back("a valid runstop message was not accepted");
   if (udp_lost != 0) failed.push_back("datagrams sent on loopback were not all read");
   if (controller_failed_steps) failed.push_back("controller steps failed");
@@ -403,6 +456,7 @@ int main(int argc, char** argv) {
     else if (flag == "--malformed-per-second") s.malformed_per_second = number(flag, value());
     else if (flag == "--rss-growth-kib") s.rss_growth_limit_kib = static_cast<long>(number(flag, value()));
     else if (flag == "--out") s.out = value();
+    else if (flag == "--authenticate") s.authenticate = true;
     else usage_error("unknown option " + flag);
   }
   try {
