@@ -28,6 +28,24 @@ def test_unknown_and_conflicting_parameters_are_refused():
     assert space.select(['speed'], ['speed=7:9'])[0].high == 9.0
 
 
+def test_an_empty_search_space_is_refused(tmp_path, capsys):
+    with pytest.raises(ToolError, match='--params: no parameter to tune'):
+        space.select([])
+    with pytest.raises(ToolError, match='--params smoothing,actuator-model: each has one value left'):
+        space.select(['smoothing', 'actuator-model'], ['smoothing=5', 'actuator-model=none'])
+    assert len(space.select(['smoothing', 'speed'], ['smoothing=5'])) == 2  # speed is still free
+    with pytest.raises(ToolError, match='--fixed speed=8: --params speed tunes that setting'):
+        space.check_fixed(space.select(['speed']), {'speed': 8})
+    with pytest.raises(ToolError, match='--fixed noise-std=.*--params noise-throttle'):
+        space.check_fixed(space.select(['noise-throttle']), {'noise-std': [0.2, 0.3]})
+    # Through the command line: refused by name before a study is made or a run driven.
+    assert tune_main(['run', '--serial', '--params', '', '--out', str(tmp_path / 'out')]) == 2
+    assert '--params: no parameter to tune (an empty search space)' in capsys.readouterr().err
+    assert tune_main(['run', '--serial', '--params', 'speed', '--fixed', 'speed=8', '--out', str(tmp_path)]) == 2
+    assert "--fixed speed=8: --params speed tunes that setting" in capsys.readouterr().err
+    assert not os.path.exists(tmp_path / 'out')
+
+
 def test_noise_channels_go_to_noise_std():
     params = space.select(['noise-steer', 'noise-throttle'])
     assert space.apply({}, params, {'noise-steer': 0.2, 'noise-throttle': 0.5}) == {'noise-std': [0.2, 0.5]}

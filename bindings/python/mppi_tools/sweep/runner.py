@@ -49,6 +49,17 @@ def plan(adapter, tasks):
     return keyed
 
 
+def collect(future, key):
+    """A finished future's result. A task that raised returns its error itself (run_task); one that
+    Dask gave up on (its workers died while running it more often than the scheduler's
+    distributed.scheduler.allowed-failures; a worker lost once only sends its tasks to the other
+    workers) is reported like a failed task, so the sweep goes on and a rerun tries it again."""
+    try:
+        return future.result()
+    except Exception as e:  # KilledWorker, CancelledError
+        return {'key': key, 'error': f'{type(e).__name__} (Dask lost the task): {e}'}
+
+
 def _progress_in_background(futures):
     """Dask's text progress bar in a thread, while the caller collects the results as they come."""
     from distributed import progress
@@ -85,8 +96,9 @@ def run_sweep(adapter, tasks, table_path, client=None, log=print):
         futures = client.map(run_task, [adapter] * len(todo), [k for k, _ in todo], [s for _, s in todo],
                              key=[f'{adapter.kind}-{k}' for k, _ in todo], pure=False)
         bar = _progress_in_background(futures)
+        keys = {future.key: key for future, (key, _) in zip(futures, todo)}
         for future in as_completed(futures):
-            record(future.result())
+            record(collect(future, keys[future.key]))
         bar.join(timeout=10)  # the bar ends with its futures; closing the client under it would cancel it
         print(flush=True)
     if todo:

@@ -50,6 +50,7 @@ def yaml_scalar(text):
 def cmd_run(args):
     params = space.select(args.params, args.range)
     fixed = fixed_settings(args.fixed)
+    space.check_fixed(params, fixed)
     evaluation = objective.Evaluation(args.tracks, args.seeds, args.laps)
     os.makedirs(args.out, exist_ok=True)
     url = args.storage or f'sqlite:///{os.path.abspath(os.path.join(args.out, "study.db"))}'

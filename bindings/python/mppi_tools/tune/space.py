@@ -60,7 +60,10 @@ DEFAULT_PARAMS = ['ess-target', 'noise-steer', 'noise-throttle', 'speed', 'track
 
 
 def select(names, ranges=()):
-    """The parameters named (in the given order), with --range overrides applied."""
+    """The parameters named (in the given order), with --range overrides applied. ToolError for
+    an unknown name and for an empty search space (no parameter, or each held to one value)."""
+    if not names:
+        raise ToolError(f'--params: no parameter to tune (an empty search space); name some of: {", ".join(BY_NAME)}')
     unknown = [n for n in names if n not in BY_NAME]
     if unknown:
         raise ToolError(f'--params: unknown {unknown}; known: {", ".join(BY_NAME)}')
@@ -85,11 +88,23 @@ def select(names, ranges=()):
         except ValueError:
             raise ToolError(f'--range {text!r}: expected {name}=LO:HI with LO < HI' if p.kind != 'choice'
                             else f'--range {text!r}: expected {name}=a|b|c') from None
+    if all(p.kind == 'choice' and len(p.choices) == 1 for p in chosen.values()):
+        raise ToolError(f'--params {",".join(chosen)}: each has one value left (--range), an empty search space; '
+                        f'set them with --fixed and tune something else')
     for p in chosen.values():
         if p.needs and p.needs[0] not in chosen:
             raise ToolError(f'--params: {p.name} needs {p.needs[0]} tuned too (it applies when {p.needs[0]} = '
                             f'{p.needs[1]})')
     return list(chosen.values())
+
+
+def check_fixed(params, fixed):
+    """ToolError for a --fixed setting that a tuned parameter sets (the trial would overwrite it)."""
+    for p in params:
+        setting = 'noise-std' if p.setting.startswith('noise-std[') else p.setting
+        if setting in fixed:
+            raise ToolError(f'--fixed {setting}={fixed[setting]}: --params {p.name} tunes that setting; '
+                            f'leave it out of --params (fixed) or out of --fixed (tuned)')
 
 
 def suggest(trial, params, fixed):
