@@ -97,6 +97,10 @@ TEST_CASE("bad closed-loop settings are rejected clearly", "[sim][closed_loop]")
   config = short_run("kinematic");
   config.track = "monza";
   CHECK_THROWS_WITH(mppi::sim::run_closed_loop(config), Catch::Contains("gazebo"));
+  // the controller's own cost map is read from the file given, and a missing one is named
+  config = short_run("kinematic");
+  config.cost_map_npz = "no_such_dir/racing_line_costmap.npz";
+  CHECK_THROWS_WITH(mppi::sim::run_closed_loop(config), Catch::Contains("racing_line_costmap.npz"));
 }
 
 namespace {
