@@ -11,12 +11,18 @@
 #include "sim/closed_loop.hpp"
 #include "sim/limit_lap_report.hpp"
 #include "sim/summary.hpp"
+#ifdef MPPI_HAVE_LAPTIME
+#include "laptime/register_collocation.hpp"
+#endif
 #ifdef MPPI_HAVE_OCS
 #include "apps/page_options.hpp"
 #include "ocs/serve.hpp"
 #endif
 
 int main(int argc, char** argv) {
+#ifdef MPPI_HAVE_LAPTIME
+  mppi::laptime::register_collocation_limit_lap();
+#endif
   CLI::App app{"MPPI driving laps of a built-in track in the headless simulator.", "mppi-sim"};
   mppi::cli::SimCommandLine cl;
   mppi::cli::add_sim_options(app, cl);
@@ -49,7 +55,7 @@ int main(int argc, char** argv) {
   try {
     if (cl.limit_lap) {
       const mppi::sim::LimitLap lap = mppi::sim::report_limit_lap(config);
-      std::printf("limit lap of the %s plant on %s%s:\n%s", config.plant.c_str(), config.track.c_str(),
+      std::printf("limit lap (%s) of the %s plant on %s%s:\n%s", config.limit_lap_method.c_str(), config.plant.c_str(), config.track.c_str(),
                   config.clockwise ? " (clockwise)" : "", mppi::sim::describe_limit_lap(lap).c_str());
       if (!config.out_dir.empty())
         std::printf("-> %s/limit_lap.csv, %s/limit_lap.png\n", config.out_dir.c_str(), config.out_dir.c_str());

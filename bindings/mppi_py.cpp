@@ -32,6 +32,9 @@
 #include "sim/data_dir.hpp"
 #include "sim/recording.hpp"
 #include "sim/summary.hpp"
+#ifdef MPPI_HAVE_LAPTIME
+#include "laptime/register_collocation.hpp"
+#endif
 
 namespace py = pybind11;
 
@@ -132,6 +135,9 @@ py::dict recording_to_dict(const mppi::sim::Recording& r) {
 }  // namespace
 
 PYBIND11_MODULE(mppi, m) {
+#ifdef MPPI_HAVE_LAPTIME
+  mppi::laptime::register_collocation_limit_lap();
+#endif
   m.doc() = "MPPI (model predictive path integral) control after AutoRally: controller, models, "
             "costs, closed-loop track simulator and recording I/O";
   py::register_exception<mppi::Error>(m, "Error", PyExc_RuntimeError);
@@ -443,6 +449,7 @@ PYBIND11_MODULE(mppi, m) {
       .def_readwrite("controller", &Cfg::controller)
       .def_readwrite("cost_params_yaml", &Cfg::cost_params_yaml)
       .def_readwrite("cost_map_npz", &Cfg::cost_map_npz)
+      .def_readwrite("limit_lap_method", &Cfg::limit_lap_method)
       .def_readwrite("plant_params_yaml", &Cfg::plant_params_yaml)
       .def_readwrite("model_params_yaml", &Cfg::model_params_yaml)
       .def_readwrite("network_npz", &Cfg::network_npz)
@@ -466,6 +473,7 @@ PYBIND11_MODULE(mppi, m) {
       .def_readonly("laps_completed", &Sum::laps_completed)
       .def_readonly("lap_times_s", &Sum::lap_times_s)
       .def_readonly("limit_lap_s", &Sum::limit_lap_s)
+      .def_readonly("limit_lap_method", &Sum::limit_lap_method)
       .def_readonly("lap_time_ratio", &Sum::lap_time_ratio)
       .def_readonly("crashes", &Sum::crashes)
       .def_readonly("crash_reasons", &Sum::crash_reasons)

@@ -177,6 +177,10 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
                  "the controller's cost map (AutoRally .npz; default: the track's own; --limit-lap writes one "
                  "around the racing line)")
       ->type_name("FILE");
+  app.add_option("--limit-lap-method", c.limit_lap_method,
+                 "how the limit lap is computed: qss (quasi-steady-state on a racing line) | collocation (the "
+                 "minimum-time lap of the single-track equations, IPOPT; docs/LIMIT_LAP.md)")
+      ->type_name("M");
   app.add_option("--plant-params", c.plant_params_yaml,
                  "the plant's data file (YAML parameters, or a corrected-model file; keys: --list-models)")
       ->type_name("FILE");

@@ -28,7 +28,7 @@ import sys
 import tempfile
 
 # Bottom first. A folder may include only folders strictly before it in this list, or itself.
-LAYERS = ['base', 'mppi', 'dynamics', 'costs', 'factory', 'vulkan', 'plot', 'chassis', 'sim',
+LAYERS = ['base', 'mppi', 'dynamics', 'costs', 'factory', 'vulkan', 'plot', 'chassis', 'sim', 'laptime',
           'cli', 'ocs', 'sysid', 'evidence', 'diagnose']
 # Programs: above every layer, may include any layer (and each other's local headers).
 TOP = ['apps', 'bindings', 'tests', 'fuzz']

@@ -12,6 +12,7 @@ MPPI_DEBIAN_PACKAGES=(
   mesa-vulkan-drivers libvulkan-dev glslang-tools spirv-tools
   libplplot-dev plplot-driver-cairo fonts-dejavu-core libcmark-gfm-dev libcmark-gfm-extensions-dev
   libcpp-httplib-dev libssl-dev nodejs npm chromium
+  coinor-libipopt-dev
 )
 
 mppi_missing_packages() {

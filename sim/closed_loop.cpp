@@ -32,6 +32,7 @@
 #include "sim/geometry.hpp"
 #include "sim/lap_counter.hpp"
 #include "sim/limit_lap.hpp"
+#include "sim/limit_lap_methods.hpp"
 #include "sim/path_predictor.hpp"
 #include "sim/recording.hpp"
 #include "sim/track_plot.hpp"
@@ -167,16 +168,16 @@ std::optional<SingleTrackParams> limit_lap_vehicle(const P& plant) {
 double vehicle_limit_lap_s(const ClosedLoopConfig& config, const SingleTrackParams& vehicle, const Track& track) {
   static std::mutex mutex;
   static std::map<std::string, LimitLap> cache;
-  const std::string key =
-      track.name() + (track.direction() == Direction::kClockwise ? " cw\n" : " ccw\n") + to_yaml(vehicle);
+  const std::string key = config.limit_lap_method + " " + track.name() +
+                          (track.direction() == Direction::kClockwise ? " cw\n" : " ccw\n") + to_yaml(vehicle);
   try {
     std::unique_lock lock(mutex);
     auto it = cache.find(key);
-    if (it == cache.end()) it = cache.emplace(key, limit_lap(track, vehicle)).first;
+    if (it == cache.end()) it = cache.emplace(key, limit_lap_by_method(config.limit_lap_method, track, vehicle)).first;
     const LimitLap& lap = it->second;
     if (config.progress)
-      std::fprintf(stderr, "limit lap of the plant's vehicle: %.2f s (mean %.2f m/s, max %.2f m/s; docs/LIMIT_LAP.md)\n",
-                   lap.lap_time_s, lap.mean_speed_mps, lap.max_speed_mps);
+      std::fprintf(stderr, "limit lap of the plant's vehicle (%s): %.2f s (mean %.2f m/s, max %.2f m/s; docs/LIMIT_LAP.md)\n",
+                   config.limit_lap_method.c_str(), lap.lap_time_s, lap.mean_speed_mps, lap.max_speed_mps);
     return lap.lap_time_s;
   } catch (const Error& e) {
     if (config.progress) std::fprintf(stderr, "no limit lap: %s\n", e.what());
@@ -257,6 +258,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   summary.target_speed_mps = config.target_speed_mps;
   summary.backend = setup.backend;
   summary.limit_lap_s = limit_lap_s;
+  if (std::isfinite(limit_lap_s)) summary.limit_lap_method = config.limit_lap_method;
   long control_step = 0;
 
   std::vector<float> model_x(static_cast<std::size_t>(setup.model_states));

@@ -57,6 +57,10 @@ struct ClosedLoopConfig {
   // Needs the single-track plant.
   std::string surface_yaml;
   ActuatorLimits actuators;               // plant actuator limits
+  // How the limit lap that laps are measured against is computed (sim/limit_lap_methods.hpp):
+  // "qss" (the quasi-steady-state lap on a racing line) or "collocation" (the minimum-time lap of
+  // the single-track equations, laptime/; where it is registered).
+  std::string limit_lap_method = "qss";
   // The actuator chain the controller plans through (sim/actuator_model.hpp): "none", "plant"
   // (the simulated car's own) or a corrected-model file; other than "none" it sets
   // controller.actuators.

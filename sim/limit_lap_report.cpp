@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "base/error.hpp"
+#include "sim/limit_lap_methods.hpp"
 #include "sim/track_plot.hpp"
 
 namespace mppi::sim {
@@ -50,13 +51,13 @@ LimitLap report_limit_lap(const ClosedLoopConfig& config) {
   TrackOptions track_options;
   track_options.direction = config.clockwise ? Direction::kClockwise : Direction::kCounterClockwise;
   const Track track = Track::load(config.track, track_options);
-  const LimitLap lap = limit_lap(track, *vehicle);
+  const LimitLap lap = limit_lap_by_method(config.limit_lap_method, track, *vehicle);
   if (!config.out_dir.empty()) {
     std::filesystem::create_directories(config.out_dir);
     write_limit_lap_csv(config.out_dir + "/limit_lap.csv", lap);
     char title[256];
-    std::snprintf(title, sizeof title, "%s | limit lap of the %s plant: %.2f s, mean %.2f m/s", track.name().c_str(),
-                  config.plant.c_str(), lap.lap_time_s, lap.mean_speed_mps);
+    std::snprintf(title, sizeof title, "%s | limit lap (%s) of the %s plant: %.2f s, mean %.2f m/s", track.name().c_str(),
+                  config.limit_lap_method.c_str(), config.plant.c_str(), lap.lap_time_s, lap.mean_speed_mps);
     plot_limit_lap(config.out_dir + "/limit_lap.png", track, lap, title);
   }
   return lap;

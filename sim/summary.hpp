@@ -30,6 +30,7 @@ struct RunSummary {
   // The limit lap of the plant's vehicle file on this track (sim/limit_lap.hpp) and each lap's
   // time over it; NaN and empty for plants without single-track parameters.
   double limit_lap_s = std::numeric_limits<double>::quiet_NaN();
+  std::string limit_lap_method;  // sim/limit_lap_methods.hpp; empty where there is no limit lap
   std::vector<double> lap_time_ratio;
   int crashes = 0;
   std::vector<std::string> crash_reasons;
