@@ -480,6 +480,12 @@ std::optional<SingleTrackParams> plant_vehicle_params(const ClosedLoopConfig& co
 
 RunSummary run_closed_loop(const ClosedLoopConfig& given) {
   ClosedLoopConfig config = given;
+  if (const auto names = limit_lap_method_names();
+      std::find(names.begin(), names.end(), config.limit_lap_method) == names.end()) {
+    std::string known;
+    for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
+    throw Error("limit_lap_method: unknown method '" + config.limit_lap_method + "' (known here: " + known + ")");
+  }
   if (!config.actuator_model.empty() && config.actuator_model != "none")
     config.controller.actuators =
         resolve_actuator_model(config.actuator_model, config.plant, config.plant_params_yaml, config.actuators);

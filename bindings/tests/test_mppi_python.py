@@ -66,6 +66,22 @@ def test_closed_loop_matches_cpp_program(cpp_run, tmp_path):
     assert json.loads(py.to_json())["lap_times_s"] == cpp["lap_times_s"]
 
 
+def test_limit_lap_by_collocation_from_python(cpp_run):
+    cpp, _ = cpp_run
+    assert cpp["limit_lap_method"] == "qss"
+    c = sim_config()
+    c.laps = 1
+    c.limit_lap_method = "collocation"
+    py = mppi.run_closed_loop(c)
+    assert py.limit_lap_method == "collocation"
+    # the car's own equations cannot hold the tyre's peak in every turn as the QSS lap assumes
+    assert py.limit_lap_s > cpp["limit_lap_s"] * 1.02
+    assert py.lap_time_ratio[0] == pytest.approx(py.lap_times_s[0] / py.limit_lap_s)
+    c.limit_lap_method = "fastest"
+    with pytest.raises(Exception, match="unknown method 'fastest'"):
+        mppi.run_closed_loop(c)
+
+
 def test_read_recording_of_cpp_run(cpp_run, tmp_path):
     cpp, out = cpp_run
     rec = mppi.read_recording(str(out / "log.csv"))
