@@ -159,7 +159,9 @@ int main(int argc, char** argv) {
         try {
           {
             const std::lock_guard<std::mutex> lock(inbox.mutex);
-            inbox.runstop_changed = !inbox.runstop || inbox.runstop->first != static_cast<bool>(m->motionEnabled);
+            // Kept until the loop reads it: a second message may come before the loop wakes.
+            inbox.runstop_changed =
+                inbox.runstop_changed || !inbox.runstop || inbox.runstop->first != static_cast<bool>(m->motionEnabled);
             inbox.runstop = std::make_pair(static_cast<bool>(m->motionEnabled), now_s());
           }
           inbox.wake.notify_one();
