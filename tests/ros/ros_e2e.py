@@ -1,12 +1,18 @@
 #!/usr/bin/env python3
 """The ROS nodes end to end, on a private roscore (a free port on 127.0.0.1).
 
-    ros_e2e.py laps   --bin BUILD/bin   mppi_sim_node + mppi_controller_node drive 3 laps of the
+    ros_e2e.py laps   --bin BUILD/ros/bin --sim-bin BUILD/bin
+                                        mppi_sim_node + mppi_controller_node drive 3 laps of the
                                         Gazebo oval; checks 0 crashes, the mean lap time within
                                         5 % of mppi-sim's at the same settings (run here), and the
                                         node's odometry-to-command latency p99 <= 20 ms at 50 Hz
-    ros_e2e.py safety --bin BUILD/bin   mppi-ros-safety-probe against mppi_controller_node: a
+    ros_e2e.py safety --bin BUILD/ros/bin --probe-bin BUILD/bin
+                                        mppi-ros-safety-probe against mppi_controller_node: a
                                         runstop and a stale pose stop the car within one period
+
+    ros_e2e.py launch --bin BUILD/ros/bin   ros/launch/closed_loop.launch by roslaunch (the nodes as
+                                        package mppi_ros), one lap with the tube variant: the lap
+                                        without a crash, and the feedback gains it publishes
 
 Prints the figures and PASS, or FAIL with the reason (exit 1). Python 3 standard library only.
 """
@@ -100,9 +106,9 @@ def tail(path, n=15):
         return ''
 
 
-def run_laps(bin_dir, scratch):
+def run_laps(bin_dir, sim_bin, scratch):
     # mppi-sim at the same settings (its plant waits for no one: simulated time).
-    sim = subprocess.run([os.path.join(bin_dir, 'mppi-sim'), '--track', 'gazebo', '--model', 'single-track',
+    sim = subprocess.run([os.path.join(sim_bin, 'mppi-sim'), '--track', 'gazebo', '--model', 'single-track',
                           '--plant', 'single-track', '--speed', str(SPEED_MPS), '--laps', str(LAPS), '--samples',
                           str(SAMPLES), '--horizon', str(HORIZON), '--seed', str(SEED), '--json', '--quiet'],
                          capture_output=True, text=True, timeout=120)
@@ -155,12 +161,12 @@ def run_laps(bin_dir, scratch):
     return '; '.join(failures)
 
 
-def run_safety(bin_dir, scratch):
+def run_safety(bin_dir, probe_bin, scratch):
     stats_file = os.path.join(scratch, 'controller_stats.json')
     with RosMaster(scratch) as ros:
         controller = start(controller_cmd(bin_dir, stats_file), ros.env, os.path.join(scratch, 'controller.log'))
         try:
-            probe = subprocess.run([os.path.join(bin_dir, 'mppi-ros-safety-probe'), '_hz:=%g' % HZ], env=ros.env,
+            probe = subprocess.run([os.path.join(probe_bin, 'mppi-ros-safety-probe'), '_hz:=%g' % HZ], env=ros.env,
                                    capture_output=True, text=True, timeout=60)
         finally:
             stop(controller, 10)
@@ -171,16 +177,68 @@ def run_safety(bin_dir, scratch):
     return ''
 
 
+def run_launch(bin_dir, scratch):
+    launch = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'ros', 'launch', 'closed_loop.launch')
+    summary_file = os.path.join(scratch, 'sim_summary.json')
+    stats_file = os.path.join(scratch, 'controller_stats.json')
+    port = free_port()
+    env = dict(os.environ, ROS_MASTER_URI='http://127.0.0.1:%d' % port, ROS_IP='127.0.0.1', ROS_HOME=scratch,
+               ROS_LOG_DIR=os.path.join(scratch, 'log'),
+               ROS_PACKAGE_PATH=os.path.dirname(os.path.abspath(bin_dir)))
+    env.pop('ROS_HOSTNAME', None)
+    proc = start(['roslaunch', '-p', str(port), launch, 'laps:=1', 'variant:=tube', 'num_rollouts:=%d' % SAMPLES,
+                  'num_timesteps:=%d' % HORIZON, 'desired_speed:=%g' % SPEED_MPS, 'summary_file:=' + summary_file,
+                  'stats_file:=' + stats_file], env, os.path.join(scratch, 'roslaunch.log'))
+    gains = None
+    try:
+        # The feedback gains, read off the topic while the car drives.
+        deadline = time.time() + 20
+        while time.time() < deadline and gains is None and proc.poll() is None:
+            echo = subprocess.run(['rostopic', 'echo', '-n', '1', '/feedbackGains/layout'], env=env,
+                                  capture_output=True, text=True, timeout=15)
+            if echo.returncode == 0 and 'label' in echo.stdout:
+                gains = echo.stdout
+        proc.wait(timeout=60)
+    except subprocess.TimeoutExpired:
+        pass
+    finally:
+        stop(proc, 10)
+    if not os.path.exists(summary_file):
+        return 'no summary from the launched mppi_sim_node:\n' + tail(os.path.join(scratch, 'roslaunch.log'))
+    with open(summary_file) as f:
+        got = json.load(f)
+    print('roslaunch closed_loop.launch (tube): laps %s s, crashes %d' %
+          (', '.join('%.2f' % t for t in got['lap_times_s']), got['crashes']))
+    failures = []
+    if got['laps'] != 1 or got['crashes'] != 0:
+        failures.append('%d laps, %d crashes (want 1 lap, no crash)' % (got['laps'], got['crashes']))
+    if gains is None:
+        failures.append('no feedbackGains from the tube controller')
+    else:
+        sizes = [int(line.split(':')[1]) for line in gains.splitlines() if line.strip().startswith('size:')]
+        print('feedbackGains layout sizes (t, control, state): %s' % sizes)
+        if sizes[:2] != [HORIZON, 2] or len(sizes) < 3 or sizes[2] < 7:
+            failures.append('feedbackGains layout %s, want [%d, 2, nx >= 7]' % (sizes, HORIZON))
+    return '; '.join(failures)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument('mode', choices=['laps', 'safety'])
-    ap.add_argument('--bin', required=True, help='folder of mppi_sim_node, mppi_controller_node, mppi-sim')
+    ap.add_argument('mode', choices=['laps', 'safety', 'launch'])
+    ap.add_argument('--bin', required=True, help='folder of mppi_sim_node and mppi_controller_node')
+    ap.add_argument('--sim-bin', help='folder of mppi-sim (laps; default: --bin)')
+    ap.add_argument('--probe-bin', help='folder of mppi-ros-safety-probe (safety; default: --bin)')
     ap.add_argument('--keep', help='keep the logs in this folder')
     args = ap.parse_args()
     scratch = args.keep or tempfile.mkdtemp(prefix='mppi_ros_e2e_')
     os.makedirs(scratch, exist_ok=True)
     try:
-        why = run_laps(args.bin, scratch) if args.mode == 'laps' else run_safety(args.bin, scratch)
+        if args.mode == 'laps':
+            why = run_laps(args.bin, args.sim_bin or args.bin, scratch)
+        elif args.mode == 'safety':
+            why = run_safety(args.bin, args.probe_bin or args.bin, scratch)
+        else:
+            why = run_launch(args.bin, scratch)
     except Exception as e:  # a test harness: any failure is reported, never a traceback alone
         why = '%s: %s' % (type(e).__name__, e)
     if why:
