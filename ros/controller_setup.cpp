@@ -15,6 +15,9 @@
 #include "sim/data_dir.hpp"
 #include "sim/path_predictor.hpp"
 #include "sim/track.hpp"
+#ifdef MPPI_HAVE_OCS
+#include "ocs/loop_page.hpp"
+#endif
 
 namespace mppi::ros {
 
@@ -27,6 +30,7 @@ bool ControllerNodeSettings::is_valid(std::string* why) const {
   if (!(desired_speed >= 0.0) || !std::isfinite(desired_speed)) return fail("desired_speed must be >= 0");
   if (!(max_throttle > -0.99 && max_throttle <= 1.0)) return fail("max_throttle must be in (-0.99, 1]");
   if (!(max_steering > 0.0 && max_steering <= 1.0)) return fail("max_steering must be in (0, 1]");
+  if (serve_port < -1 || serve_port > 65535) return fail("serve_port must be -1 (none) or a port in [0, 65535]");
   if (backend != "cpu" && backend != "vulkan" && backend != "auto")
     return fail("backend must be cpu, vulkan or auto, got '" + backend + "'");
   ControllerVariant v;
@@ -62,6 +66,9 @@ struct NodeController::Impl {
   std::vector<float> x;
   std::vector<float> gains;
   StepSummary summary;
+#ifdef MPPI_HAVE_OCS
+  std::unique_ptr<ocs::LoopPage> page;
+#endif
 };
 
 NodeController::NodeController(const ControllerNodeSettings& s) : impl_(std::make_unique<Impl>()) {
@@ -92,15 +99,36 @@ NodeController::NodeController(const ControllerNodeSettings& s) : impl_(std::mak
     d.predict = sim::make_path_predictor(model, options.dt_s);
   }, "model");
   d.x.assign(static_cast<std::size_t>(d.model_states), 0.f);
+  if (s.serve_port >= 0) {
+#ifdef MPPI_HAVE_OCS
+    ocs::ServerSettings page;
+    page.port = s.serve_port;
+    d.page = std::make_unique<ocs::LoopPage>(page, s.map_path.empty() ? s.track : std::string(), d.predict,
+                                             s.desired_speed);
+#else
+    throw Error("serve_port: this build has no operator page (ocs/CMakeLists.txt says why)");
+#endif
+  }
 }
 
 NodeController::~NodeController() = default;
 
-NodeController::Step NodeController::step(const VehicleState& state) {
+NodeController::Step NodeController::step(const VehicleState& state, double t_s, Control applied,
+                                          bool motion_enabled) {
   Impl& d = *impl_;
   const auto common = state.to_array();
   d.observe(common.data(), d.x.data());
+#ifdef MPPI_HAVE_OCS
+  if (d.page) d.page->apply_requests(*d.controller);
+#endif
   const auto u = d.controller->step(d.x, &d.summary);
+#ifdef MPPI_HAVE_OCS
+  if (d.page)
+    d.page->after_step(t_s, state, d.x, Control{u[control::kSteer], u[control::kThrottle]}, applied, d.summary,
+                       *d.controller, motion_enabled, false);
+#else
+  (void)t_s, (void)applied, (void)motion_enabled;
+#endif
   Step out;
   out.ok = d.summary.status == StepStatus::kOk;
   out.reason = d.summary.reason;
@@ -115,6 +143,13 @@ void NodeController::planned_path(std::vector<float>* xy) const {
   const Impl& d = *impl_;
   xy->assign(static_cast<std::size_t>(horizon() + 1) * 2, 0.f);
   d.predict(d.x, d.controller->nominal(), 1, *xy);
+}
+
+bool NodeController::page_motion_allowed() const {
+#ifdef MPPI_HAVE_OCS
+  if (impl_->page) return impl_->page->motion_allowed();
+#endif
+  return true;
 }
 
 const std::vector<float>& NodeController::feedback_gains() const { return impl_->gains; }

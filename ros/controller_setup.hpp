@@ -39,6 +39,9 @@ struct ControllerNodeSettings {
   std::string variant = "plain";    // plain | tube | robust
   int num_threads = 0;              // CPU threads; 0 = OpenMP default
   std::uint64_t seed = 1;
+  // The operator page (docs/OCS.md) on http://127.0.0.1:serve_port/ (0 = any free port, its URL
+  // with the page's token printed); -1 = none. Only in a build with the page (ocs/).
+  int serve_port = -1;
 
   // Checks ranges and names; on failure writes which parameter and why.
   bool is_valid(std::string* why) const;
@@ -60,7 +63,12 @@ class NodeController {
     Control output;
     double optimizer_ms = 0.0;
   };
-  Step step(const VehicleState& state);
+  // One step on the measured state at node time t_s; `applied` and `motion_enabled` (the
+  // chassis' actuators and runstop, as it reports them) are shown on the operator page.
+  Step step(const VehicleState& state, double t_s = 0.0, Control applied = {}, bool motion_enabled = true);
+  // The operator page's runstop: false once its RUNSTOP was pressed (until released); true
+  // without a page.
+  bool page_motion_allowed() const;
 
   // The plan's path from the last state stepped on: (T + 1) x (x, y), row-major.
   void planned_path(std::vector<float>* xy) const;

@@ -17,7 +17,7 @@ bool SafetySettings::is_valid(std::string* why) const {
 }
 
 bool SafetyMonitor::motion_allowed(double now_s) const {
-  if (!motion_enabled_) return false;
+  if (!motion_enabled_ || !page_motion_allowed_) return false;
   if (settings_.require_runstop)
     return last_runstop_s_ && now_s - *last_runstop_s_ <= settings_.runstop_timeout_s;
   return true;
@@ -36,7 +36,9 @@ NodeStatus SafetyMonitor::status(double now_s) const {
     s.info = "Controller error: " + step_error_;
   } else if (!motion_allowed(now_s)) {
     s.level = StatusLevel::kWarning;
-    s.info = motion_enabled_ ? "Safe speed zero: no runstop heard." : "Safe speed zero: runstop.";
+    s.info = !motion_enabled_       ? "Safe speed zero: runstop."
+             : !page_motion_allowed_ ? "Safe speed zero: operator page runstop."
+                                     : "Safe speed zero: no runstop heard.";
   } else {
     s.level = StatusLevel::kOk;
     s.info = "Controller OK";

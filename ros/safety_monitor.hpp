@@ -36,6 +36,8 @@ class SafetyMonitor {
     motion_enabled_ = motion_enabled;
     last_runstop_s_ = now_s;
   }
+  // The operator page's runstop (a second operator, beside the runstop messages).
+  void on_operator_page(bool motion_allowed) { page_motion_allowed_ = motion_allowed; }
   // The controller's last step: ok, or failed with a reason (cleared by the next good step).
   void on_step(bool ok, const std::string& reason = {}) { step_error_ = ok ? std::string() : reason; }
 
@@ -49,6 +51,7 @@ class SafetyMonitor {
   SafetySettings settings_;
   std::optional<double> last_pose_s_, last_runstop_s_;
   bool motion_enabled_ = true;
+  bool page_motion_allowed_ = true;
   std::string step_error_;
 };
 

@@ -114,6 +114,7 @@ int main(int argc, char** argv) {
     read_param(nh, "runstop_timeout_s", safety.runstop_timeout_s);
     read_param(nh, "stats_file", stats_file);
     read_param(nh, "path_every", path_every);
+    read_param(nh, "serve_port", s.serve_port);
     std::string why;
     if (!safety.is_valid(&why)) throw mppi::Error("controller node parameters: " + why);
   } catch (const std::exception& e) {
@@ -139,7 +140,9 @@ int main(int argc, char** argv) {
   if (s.variant != "plain") gains_pub = pub_nh.advertise<std_msgs::Float32MultiArray>("feedbackGains", 1);
 
   Inbox inbox;
-  std::atomic<double> applied_steer{0.0}, applied_throttle{0.0};  // from chassisState, for the operator
+  // From chassisState, for the operator page (the models read the pose).
+  std::atomic<double> applied_steer{0.0}, applied_throttle{0.0};
+  std::atomic<bool> chassis_motion{true};
   ros::Subscriber pose_sub = pub_nh.subscribe<nav_msgs::Odometry>(
       pose_topic, 1, [&](const nav_msgs::Odometry::ConstPtr& m) {
         try {
@@ -171,8 +174,9 @@ int main(int argc, char** argv) {
       }, ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   ros::Subscriber state_sub = pub_nh.subscribe<autorally_msgs::chassisState>(
       "chassisState", 1, [&](const autorally_msgs::chassisState::ConstPtr& m) {
-        applied_steer = m->steering;  // the models read the pose; these are kept for logs
+        applied_steer = m->steering;
         applied_throttle = m->throttle;
+        chassis_motion = static_cast<bool>(m->runstopMotionEnabled);
       });
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
@@ -219,6 +223,7 @@ int main(int argc, char** argv) {
     if (!ros::ok() || g_stop) break;
     try {
       const double t = now_s();
+      monitor.on_operator_page(controller->page_motion_allowed());
       mppi::ros::NodeStatus status = monitor.status(t);
       if (status.safe_stop) {
         // Every period (and at once on a runstop): the safe stop. The plan is kept warm.
@@ -238,7 +243,9 @@ int main(int argc, char** argv) {
           publish_command(0.0, 0.0);
           stats.count_error();
         } else {
-          const mppi::ros::NodeController::Step step = controller->step(state);
+          const mppi::ros::NodeController::Step step = controller->step(
+              state, t, mppi::Control{static_cast<float>(applied_steer.load()), static_cast<float>(applied_throttle.load())},
+              chassis_motion.load());
           monitor.on_step(step.ok, step.reason);
           if (step.ok) {
             publish_command(step.output.steer, step.output.throttle);

@@ -12,13 +12,18 @@
 
     ros_e2e.py launch --bin BUILD/ros/bin   ros/launch/closed_loop.launch by roslaunch (the nodes as
                                         package mppi_ros), one lap with the tube variant: the lap
-                                        without a crash, and the feedback gains it publishes
+                                        without a crash, the feedback gains it publishes, and the
+                                        operator page's runstop (when the page is built) in the
+                                        node's pathIntegralStatus
 
 Prints the figures and PASS, or FAIL with the reason (exit 1). Python 3 standard library only.
 """
 import argparse
 import json
 import os
+import re
+import urllib.error
+import urllib.request
 import signal
 import socket
 import subprocess
@@ -184,12 +189,18 @@ def run_launch(bin_dir, scratch):
     port = free_port()
     env = dict(os.environ, ROS_MASTER_URI='http://127.0.0.1:%d' % port, ROS_IP='127.0.0.1', ROS_HOME=scratch,
                ROS_LOG_DIR=os.path.join(scratch, 'log'),
-               ROS_PACKAGE_PATH=os.path.dirname(os.path.abspath(bin_dir)))
+               ROS_PACKAGE_PATH=os.path.dirname(os.path.abspath(bin_dir)),
+               # the generated autorally_msgs classes, for rostopic
+               PYTHONPATH=os.pathsep.join(p for p in [os.path.join(os.path.dirname(os.path.abspath(bin_dir)), 'python'),
+                                                      os.environ.get('PYTHONPATH', '')] if p))
     env.pop('ROS_HOSTNAME', None)
+    page_port = free_port()
+    log_path = os.path.join(scratch, 'roslaunch.log')
     proc = start(['roslaunch', '-p', str(port), launch, 'laps:=1', 'variant:=tube', 'num_rollouts:=%d' % SAMPLES,
                   'num_timesteps:=%d' % HORIZON, 'desired_speed:=%g' % SPEED_MPS, 'summary_file:=' + summary_file,
-                  'stats_file:=' + stats_file], env, os.path.join(scratch, 'roslaunch.log'))
+                  'stats_file:=' + stats_file, 'serve_port:=%d' % page_port], env, log_path)
     gains = None
+    page_runstop = None  # None: no page in this build; else what the node's status said
     try:
         # The feedback gains, read off the topic while the car drives.
         deadline = time.time() + 20
@@ -198,6 +209,23 @@ def run_launch(bin_dir, scratch):
                                   capture_output=True, text=True, timeout=15)
             if echo.returncode == 0 and 'label' in echo.stdout:
                 gains = echo.stdout
+        # The operator page's RUNSTOP: the node's status says so, then released.
+        with open(log_path) as f:
+            token = re.search(r'127\.0\.0\.1:%d/\?token=([0-9a-f]+)' % page_port, f.read())
+        if token:
+            def control(query):
+                req = urllib.request.Request('http://127.0.0.1:%d/api/control?%s' % (page_port, query), data=b'',
+                                            method='POST', headers={'X-MPPI-Token': token.group(1)})
+                with urllib.request.urlopen(req, timeout=5) as r:
+                    return r.status
+            page_runstop = 'POST runstop=1 answered %s' % control('runstop=1')
+            for _ in range(5):
+                status = subprocess.run(['rostopic', 'echo', '-n', '1', '/pathIntegralStatus/info'], env=env,
+                                        capture_output=True, text=True, timeout=15).stdout
+                if 'operator page' in status:
+                    page_runstop = 'status: ' + status.split('\n')[0]
+                    break
+            control('runstop=0')
         proc.wait(timeout=60)
     except subprocess.TimeoutExpired:
         pass
@@ -219,6 +247,10 @@ def run_launch(bin_dir, scratch):
         print('feedbackGains layout sizes (t, control, state): %s' % sizes)
         if sizes[:2] != [HORIZON, 2] or len(sizes) < 3 or sizes[2] < 7:
             failures.append('feedbackGains layout %s, want [%d, 2, nx >= 7]' % (sizes, HORIZON))
+    if page_runstop is not None:
+        print('operator page runstop -> %s' % page_runstop)
+        if 'operator page' not in page_runstop:
+            failures.append('the operator page\'s runstop did not reach the node\'s status (%s)' % page_runstop)
     return '; '.join(failures)
 
 
