@@ -44,6 +44,9 @@ class SafetyMonitor {
   bool pose_received() const { return last_pose_s_.has_value(); }
   bool pose_stale(double now_s) const { return !last_pose_s_ || now_s - *last_pose_s_ > settings_.pose_timeout_s; }
   bool motion_allowed(double now_s) const;
+  // Whether the controller may step: a fresh pose and motion allowed. A failed step does not
+  // count here: its output is the stop, and the next pose gets a new step (which clears it).
+  bool may_step(double now_s) const { return !pose_stale(now_s) && motion_allowed(now_s); }
   NodeStatus status(double now_s) const;
   const SafetySettings& settings() const { return settings_; }
 

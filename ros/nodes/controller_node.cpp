@@ -225,7 +225,7 @@ int main(int argc, char** argv) {
       const double t = now_s();
       monitor.on_operator_page(controller->page_motion_allowed());
       mppi::ros::NodeStatus status = monitor.status(t);
-      if (status.safe_stop) {
+      if (!monitor.may_step(t)) {
         // Every period (and at once on a runstop): the safe stop. The plan is kept warm.
         if (runstop_changed || !stopped_sent || t - last_step_s >= period_s * 0.999) {
           publish_command(0.0, 0.0);

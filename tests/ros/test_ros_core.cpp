@@ -67,6 +67,7 @@ TEST_CASE("the safety monitor: no pose, stale pose, runstop and errors give Auto
   CHECK_FALSE(st.safe_stop);
   CHECK_FALSE(m.pose_stale(1.5));
   st = m.status(1.51);  // older than 0.5 s
+  CHECK_FALSE(m.may_step(1.51));
   CHECK(st.level == StatusLevel::kError);
   CHECK(st.info == "POSE STALE");
   CHECK(st.safe_stop);
@@ -81,6 +82,8 @@ TEST_CASE("the safety monitor: no pose, stale pose, runstop and errors give Auto
   st = m.status(2.04);
   CHECK(st.level == StatusLevel::kError);
   CHECK(st.info.find("backend lost") != std::string::npos);
+  CHECK(st.safe_stop);
+  CHECK(m.may_step(2.04));  // the next pose gets a new step, which may clear the error
   m.on_step(true);
   CHECK(m.status(2.05).level == StatusLevel::kOk);
 }
