@@ -3,7 +3,8 @@
 // rate-limited actuators with optional pure delays (~steering_delay_s, ~throttle_delay_s),
 // integrated in real time. Publishes /pose_estimate (nav_msgs/Odometry, AutoRally's convention:
 // world-frame twist) and chassisState at ~rate_hz; drives on chassisCommand, stops on runstop.
-// The car waits at the start line until the first command; laps are timed from then. With
+// The car waits at the start line until the first command that asks for motion; laps are timed
+// from then. With
 // ~laps > 0 it writes its summary (laps, lap times, crashes) to ~summary_file and exits after
 // that many laps. Nothing thrown leaves a callback.
 #include <atomic>
@@ -111,7 +112,9 @@ int main(int argc, char** argv) {
         if (motion_enabled) car->set_motion_enabled(*motion_enabled);
       }
       const auto now = Clock::now();
-      if (u && !t0) t0 = now;
+      // The clock starts with the first command that asks for motion (a controller's neutral
+      // commands while it waits for its first pose leave the car at rest, untimed).
+      if (u && !t0 && (u->steer != 0.f || u->throttle != 0.f)) t0 = now;
       if (t0) {
         const double t = std::chrono::duration<double>(now - *t0).count();
         car->advance_to(t);
