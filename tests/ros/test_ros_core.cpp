@@ -149,6 +149,14 @@ TEST_CASE("controller node settings map AutoRally's parameter names onto the opt
   CHECK_FALSE(s.is_valid(&why));
   CHECK(why.find("backend") != std::string::npos);
   s.backend = "cpu";
+  s.serve_port = 70000;
+  CHECK_FALSE(s.is_valid(&why));
+  CHECK(why.find("serve_port") != std::string::npos);
+  s.serve_port = -1;
+  s.hz = 0.0;
+  CHECK_FALSE(s.is_valid(&why));
+  CHECK(why.find("hz") != std::string::npos);
+  s.hz = 50.0;
   s.model = "tricycle";
   CHECK_THROWS_WITH(NodeController(s), Catch::Contains("tricycle"));
 }
