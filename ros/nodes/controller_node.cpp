@@ -73,9 +73,11 @@ double now_s() { return ros::Time::now().toSec(); }
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }  // the loop ends within a control period
 
+// A private parameter, if set; one of another type is refused by name (not silently ignored).
 template <class T>
 void read_param(ros::NodeHandle& nh, const std::string& name, T& value) {
-  nh.param(name, value, value);
+  if (nh.hasParam(name) && !nh.getParam(name, value))
+    throw mppi::Error("parameter " + nh.resolveName(name) + " has the wrong type");
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <csignal>
 #include <cstdio>
 #include <exception>
+#include <stdexcept>
 #include <fstream>
 #include <mutex>
 #include <optional>
@@ -33,6 +34,13 @@ namespace {
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
 
+// A private parameter, if set; one of another type is refused by name (not silently ignored).
+template <class T>
+void read_param(ros::NodeHandle& nh, const std::string& name, T& value) {
+  if (nh.hasParam(name) && !nh.getParam(name, value))
+    throw std::runtime_error("parameter " + nh.resolveName(name) + " has the wrong type");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -44,18 +52,18 @@ int main(int argc, char** argv) {
   std::string summary_file, pose_topic = "/pose_estimate", frame_id = "map";
   std::optional<mppi::ros::SimCar> car;
   try {
-    nh.param("track", settings.track, settings.track);
-    nh.param("plant_params", settings.plant_params, settings.plant_params);
-    nh.param("plant_dt_s", settings.plant_dt_s, settings.plant_dt_s);
-    nh.param("steering_delay_s", settings.steering_delay_s, settings.steering_delay_s);
-    nh.param("throttle_delay_s", settings.throttle_delay_s, settings.throttle_delay_s);
-    nh.param("rate_hz", rate_hz, rate_hz);
-    nh.param("integration_hz", integration_hz, integration_hz);
-    nh.param("laps", laps, laps);
-    nh.param("max_time_s", max_time_s, max_time_s);
-    nh.param("summary_file", summary_file, summary_file);
-    nh.param("pose_estimate", pose_topic, pose_topic);
-    nh.param("frame_id", frame_id, frame_id);
+    read_param(nh, "track", settings.track);
+    read_param(nh, "plant_params", settings.plant_params);
+    read_param(nh, "plant_dt_s", settings.plant_dt_s);
+    read_param(nh, "steering_delay_s", settings.steering_delay_s);
+    read_param(nh, "throttle_delay_s", settings.throttle_delay_s);
+    read_param(nh, "rate_hz", rate_hz);
+    read_param(nh, "integration_hz", integration_hz);
+    read_param(nh, "laps", laps);
+    read_param(nh, "max_time_s", max_time_s);
+    read_param(nh, "summary_file", summary_file);
+    read_param(nh, "pose_estimate", pose_topic);
+    read_param(nh, "frame_id", frame_id);
     if (!(rate_hz > 0.0 && rate_hz <= 1000.0)) throw std::runtime_error("rate_hz must be in (0, 1000]");
     if (!(integration_hz >= rate_hz && integration_hz <= 5000.0))
       throw std::runtime_error("integration_hz must be in [rate_hz, 5000]");
