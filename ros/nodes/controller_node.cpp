@@ -33,30 +33,12 @@
 #include "ros/controller_setup.hpp"
 #include "ros/latency_stats.hpp"
 #include "ros/odometry_state.hpp"
+#include "ros/nodes/ros_messages.hpp"
 #include "ros/safety_monitor.hpp"
 
 namespace {
 
 using mppi::ros::OdometryFields;
-
-OdometryFields fields_of(const nav_msgs::Odometry& m) {
-  OdometryFields o;
-  o.stamp_s = m.header.stamp.toSec();
-  o.x_m = m.pose.pose.position.x;
-  o.y_m = m.pose.pose.position.y;
-  o.z_m = m.pose.pose.position.z;
-  o.qw = m.pose.pose.orientation.w;
-  o.qx = m.pose.pose.orientation.x;
-  o.qy = m.pose.pose.orientation.y;
-  o.qz = m.pose.pose.orientation.z;
-  o.vx_world_mps = m.twist.twist.linear.x;
-  o.vy_world_mps = m.twist.twist.linear.y;
-  o.vz_world_mps = m.twist.twist.linear.z;
-  o.roll_rate_radps = m.twist.twist.angular.x;
-  o.pitch_rate_radps = m.twist.twist.angular.y;
-  o.yaw_rate_radps = m.twist.twist.angular.z;
-  return o;
-}
 
 // What the callbacks hand to the control loop.
 struct Inbox {
@@ -148,7 +130,7 @@ int main(int argc, char** argv) {
   ros::Subscriber pose_sub = pub_nh.subscribe<nav_msgs::Odometry>(
       pose_topic, 1, [&](const nav_msgs::Odometry::ConstPtr& m) {
         try {
-          const OdometryFields f = fields_of(*m);
+          const OdometryFields f = mppi::ros::fields_of(*m);
           {
             const std::lock_guard<std::mutex> lock(inbox.mutex);
             inbox.pose = f;
@@ -261,37 +243,11 @@ int main(int argc, char** argv) {
           // The plan's path (from the measured state) and the feedback gains, after the command.
           if (path_every > 0 && steps % path_every == 0 && path_pub.getNumSubscribers() > 0) {
             controller->planned_path(&path_xy);
-            const int horizon = controller->horizon();
-            nav_msgs::Path path;
-            path.header.stamp = ros::Time::now();
-            path.header.frame_id = "map";
-            path.poses.resize(static_cast<std::size_t>(horizon + 1));
-            for (int i = 0; i <= horizon; ++i) {
-              auto& p = path.poses[static_cast<std::size_t>(i)];
-              p.header.stamp = path.header.stamp + ros::Duration(i * period_s);
-              p.header.frame_id = "map";
-              p.pose.position.x = path_xy[static_cast<std::size_t>(i) * 2];
-              p.pose.position.y = path_xy[static_cast<std::size_t>(i) * 2 + 1];
-              p.pose.orientation.w = 1.0;
-            }
-            path_pub.publish(path);
+            path_pub.publish(mppi::ros::path_msg(path_xy, period_s, ros::Time::now(), "map"));
           }
           if (gains_pub && !controller->feedback_gains().empty()) {
-            std_msgs::Float32MultiArray g;
-            const std::vector<float>& gains = controller->feedback_gains();
-            const int nu = controller->controls(), nx = controller->model_states();
-            g.layout.dim.resize(3);
-            g.layout.dim[0].label = "t";
-            g.layout.dim[0].size = static_cast<unsigned>(s.num_timesteps);
-            g.layout.dim[0].stride = static_cast<unsigned>(s.num_timesteps * nu * nx);
-            g.layout.dim[1].label = "control";
-            g.layout.dim[1].size = static_cast<unsigned>(nu);
-            g.layout.dim[1].stride = static_cast<unsigned>(nu * nx);
-            g.layout.dim[2].label = "state";
-            g.layout.dim[2].size = static_cast<unsigned>(nx);
-            g.layout.dim[2].stride = static_cast<unsigned>(nx);
-            g.data.assign(gains.begin(), gains.end());
-            gains_pub.publish(g);
+            gains_pub.publish(mppi::ros::gains_msg(controller->feedback_gains(), controller->horizon(),
+                                                   controller->controls(), controller->model_states()));
           }
         }
         last_step_s = t;

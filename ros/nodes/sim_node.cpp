@@ -26,7 +26,7 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 
-#include "ros/odometry_state.hpp"
+#include "ros/nodes/ros_messages.hpp"
 #include "ros/sim_car.hpp"
 
 namespace {
@@ -107,9 +107,6 @@ int main(int argc, char** argv) {
   auto next = Clock::now();
   long ticks = 0;
   int rc = 0;
-  nav_msgs::Odometry odom;
-  odom.header.frame_id = frame_id;
-  odom.child_frame_id = "base_link";
   autorally_msgs::chassisState cs;
   try {
     while (ros::ok() && !g_stop) {
@@ -129,18 +126,7 @@ int main(int argc, char** argv) {
         if (u) car->command(*u, car->time_s());
       }
       if (ticks % publish_every == 0) {
-        const mppi::ros::OdometryFields o = mppi::ros::odometry_from_state(car->state(), 0.0);
-        odom.header.stamp = ros::Time::now();
-        odom.pose.pose.position.x = o.x_m;
-        odom.pose.pose.position.y = o.y_m;
-        odom.pose.pose.position.z = 0.0;
-        odom.pose.pose.orientation.w = o.qw;
-        odom.pose.pose.orientation.x = o.qx;
-        odom.pose.pose.orientation.y = o.qy;
-        odom.pose.pose.orientation.z = o.qz;
-        odom.twist.twist.linear.x = o.vx_world_mps;
-        odom.twist.twist.linear.y = o.vy_world_mps;
-        odom.twist.twist.angular.z = o.yaw_rate_radps;
+        const nav_msgs::Odometry odom = mppi::ros::odometry_msg(car->state(), ros::Time::now(), frame_id);
         pose_pub.publish(odom);
         cs.header.stamp = odom.header.stamp;
         cs.throttleRelayEnabled = true;

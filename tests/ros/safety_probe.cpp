@@ -18,7 +18,7 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 
-#include "ros/odometry_state.hpp"
+#include "ros/nodes/ros_messages.hpp"
 #include "ros/sim_car.hpp"
 
 namespace {
@@ -81,20 +81,7 @@ int main(int argc, char** argv) {
       }
       car.advance_to(t);
       if (poses) {
-        const mppi::ros::OdometryFields o = mppi::ros::odometry_from_state(car.state(), 0.0);
-        nav_msgs::Odometry odom;
-        odom.header.stamp = ros::Time::now();
-        odom.header.frame_id = "map";
-        odom.pose.pose.position.x = o.x_m;
-        odom.pose.pose.position.y = o.y_m;
-        odom.pose.pose.orientation.w = o.qw;
-        odom.pose.pose.orientation.x = o.qx;
-        odom.pose.pose.orientation.y = o.qy;
-        odom.pose.pose.orientation.z = o.qz;
-        odom.twist.twist.linear.x = o.vx_world_mps;
-        odom.twist.twist.linear.y = o.vy_world_mps;
-        odom.twist.twist.angular.z = o.yaw_rate_radps;
-        pose_pub.publish(odom);
+        pose_pub.publish(mppi::ros::odometry_msg(car.state(), ros::Time::now(), "map"));
       }
       if (n++ % 5 == 0) {
         autorally_msgs::runstop r;
