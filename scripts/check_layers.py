@@ -29,7 +29,7 @@ import tempfile
 
 # Bottom first. A folder may include only folders strictly before it in this list, or itself.
 LAYERS = ['base', 'mppi', 'dynamics', 'costs', 'factory', 'vulkan', 'plot', 'chassis', 'sim', 'laptime',
-          'cli', 'ocs', 'sysid', 'evidence', 'diagnose']
+          'cli', 'ocs', 'sysid', 'evidence', 'diagnose', 'ros']
 # Programs: above every layer, may include any layer (and each other's local headers).
 TOP = ['apps', 'bindings', 'tests', 'fuzz']
 # Folders whose code is in namespace mppi itself (and helpers nested in it).

@@ -13,6 +13,9 @@ MPPI_DEBIAN_PACKAGES=(
   libplplot-dev plplot-driver-cairo fonts-dejavu-core libcmark-gfm-dev libcmark-gfm-extensions-dev
   libcpp-httplib-dev libssl-dev nodejs npm chromium
   coinor-libipopt-dev
+  # ROS 1 (Debian's packages) for the nodes in ros/ (docs/ROS.md); the build goes on without them.
+  ros-core-dev catkin ros-message-generation ros-std-msgs ros-geometry-msgs ros-nav-msgs
+  python3-rospy python3-rosbag librosbag-dev
 )
 
 mppi_missing_packages() {
