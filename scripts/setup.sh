@@ -12,6 +12,7 @@ MPPI_DEBIAN_PACKAGES=(
   mesa-vulkan-drivers libvulkan-dev glslang-tools spirv-tools
   libplplot-dev plplot-driver-cairo fonts-dejavu-core libcmark-gfm-dev libcmark-gfm-extensions-dev
   libcpp-httplib-dev libssl-dev nodejs npm chromium
+  librosbag-dev python3-rosbag python3-genpy python3-nav-msgs python3-geometry-msgs
 )
 
 mppi_missing_packages() {
