@@ -10,6 +10,7 @@
 #include <rosbag/view.h>
 
 #include "base/error.hpp"
+#include "sysid/rosbag/bag_structure.hpp"
 
 namespace mppi::sysid::bag {
 
@@ -41,6 +42,7 @@ BagFile::BagFile(const std::string& path) : path_(path), impl_(std::make_unique<
     if (probe.gcount() < 13 || std::string(magic, 13) != "#ROSBAG V2.0\n")
       throw Error(path + ": not a rosbag (format 2.0 starts with '#ROSBAG V2.0')");
   }
+  check_bag_structure(path);  // librosbag reads past its buffers on damaged chunks
   guarded(path_, "opening", [&] {
     impl_->bag.open(path_, ::rosbag::bagmode::Read);
     ::rosbag::View all(impl_->bag);
