@@ -139,6 +139,18 @@ TEST_CASE("rosbag import: another stack's topics through a topic map file", "[ro
   CHECK(read_bag_recording(bag("other_stack.bag"), world).column("vy")[100] == Approx(-kV * std::sin(kW * 1.0)));
 }
 
+TEST_CASE("rosbag import: a namespaced topic is found by its last name", "[rosbag]") {
+  const mppi::sim::Recording rec = read_bag_recording(bag("namespaced.bag"));
+  CHECK(rec.metadata.at("controls") == "/autorally_platform/chassisState (chassis state)");
+  CHECK(rec.column("steer").back() == Approx(0.25));
+  CHECK(rec.column("wheel_speed").back() == Approx(2.0));
+  const BagFile file(bag("namespaced.bag"));
+  CHECK(file.resolve("chassisState") == "/autorally_platform/chassisState");
+  CHECK(file.resolve("/pose_estimate") == "/pose_estimate");
+  CHECK(file.resolve("pose_estimate") == "/pose_estimate");
+  CHECK(file.resolve("/chassisCommand").empty());
+}
+
 TEST_CASE("rosbag import: a topic map with an unknown key or a bad value is refused by name", "[rosbag]") {
   BagTopicMap map;
   CHECK(error_of([&] { map.apply_pairs("pose=/odom,speed=/v"); }).find("--topic: unknown topic map key 'speed'") == 0);
@@ -205,6 +217,14 @@ TEST_CASE("rosbag import: a truncated or damaged or foreign file is refused nami
   const std::string hurt = bag_dir() + "/damaged.bag";
   std::ofstream(hurt, std::ios::binary).write(damaged.data(), static_cast<std::streamsize>(damaged.size()));
   CHECK(error_of([&] { read_bag_recording(hurt); }).find(hurt + ": damaged rosbag: a record header inside a chunk runs past the chunk") == 0);
+  // A bag whose recording did not end cleanly has no index (index_pos 0).
+  std::string unindexed = bytes;
+  const std::size_t index_pos = unindexed.find("index_pos=");
+  REQUIRE(index_pos != std::string::npos);
+  for (int i = 0; i < 8; ++i) unindexed[index_pos + 10 + i] = 0;
+  const std::string active = bag_dir() + "/unindexed.bag";
+  std::ofstream(active, std::ios::binary).write(unindexed.data(), static_cast<std::streamsize>(unindexed.size()));
+  CHECK(error_of([&] { read_bag_recording(active); }).find(active + ": damaged rosbag: the bag is not indexed") == 0);
   const std::string csv = bag_dir() + "/not_a_bag.bag";
   std::ofstream(csv) << "t,x,y\n0,1,2\n";
   CHECK(error_of([&] { read_bag_recording(csv); }) ==

@@ -13,6 +13,7 @@ circle.bag     4 s at 2 m/s on a circle of radius 4 m (yaw rate 0.5 rad/s), Auto
                /wheelSpeeds   100 Hz: lf 1.9, rf 2.1, lb 1.8, rb 2.2
 circle_lz4.bag the same, lz4-compressed chunks; circle_bz2.bag bz2
 other_stack.bag the same drive as /odom (twist in the body frame) and /cmd (chassisCommand) only
+namespaced.bag  the drive with /autorally_platform/chassisState and /autorally_platform/wheelSpeeds
 no_controls.bag /pose_estimate and /wheelSpeeds only
 no_pose.bag     /chassisCommand and /chassisState only
 wrong_type.bag  /pose_estimate as geometry_msgs/PoseStamped
@@ -101,6 +102,8 @@ def main(out):
     write_drive(os.path.join(out, "circle_bz2.bag"), msgs, compression="bz2")
     write_drive(os.path.join(out, "other_stack.bag"), msgs, pose_topic="/odom", command_topic="/cmd", state_topic="",
                 wheel_topic="", world_twist=False)
+    write_drive(os.path.join(out, "namespaced.bag"), msgs, command_topic="", state_topic="/autorally_platform/chassisState",
+                wheel_topic="/autorally_platform/wheelSpeeds")
     write_drive(os.path.join(out, "no_controls.bag"), msgs, command_topic="", state_topic="")
     write_drive(os.path.join(out, "no_pose.bag"), msgs, pose_topic="", wheel_topic="")
     with rosbag.Bag(os.path.join(out, "wrong_type.bag"), "w") as bag:
