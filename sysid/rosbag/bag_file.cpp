@@ -103,20 +103,17 @@ void BagFile::check_type(const std::string& topic, const MessageType& type) cons
   }
 }
 
-std::vector<RawMessage> BagFile::messages(const std::string& topic) const {
-  return guarded(path_, ("reading topic " + topic).c_str(), [&] {
-    std::vector<RawMessage> out;
+void BagFile::for_each_message(const std::string& topic, const MessageVisitor& visit) const {
+  guarded(path_, ("reading topic " + topic).c_str(), [&] {
+    std::vector<std::uint8_t> bytes;
     ::rosbag::View view(impl_->bag, ::rosbag::TopicQuery(topic));
-    out.reserve(view.size());
     for (const ::rosbag::MessageInstance& m : view) {
-      RawMessage r;
-      r.receive_time_ns = static_cast<std::int64_t>(m.getTime().toNSec());
-      r.bytes.resize(m.size());
-      ros::serialization::OStream stream(r.bytes.data(), static_cast<std::uint32_t>(r.bytes.size()));
+      bytes.resize(m.size());
+      ros::serialization::OStream stream(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
       m.write(stream);
-      out.push_back(std::move(r));
+      visit(static_cast<std::int64_t>(m.getTime().toNSec()), bytes);
     }
-    return out;
+    return 0;
   });
 }
 

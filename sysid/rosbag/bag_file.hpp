@@ -4,6 +4,7 @@
 // not a bag, a truncated or unindexed one, a chunk that does not decompress) come out as
 // mppi::Error naming the file.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,10 +20,8 @@ struct TopicInfo {
   std::size_t messages = 0;
 };
 
-struct RawMessage {
-  std::int64_t receive_time_ns = 0;  // the bag's time of the message
-  std::vector<std::uint8_t> bytes;
-};
+// One serialised message: the bag's time of it [ns] and its bytes (valid during the call only).
+using MessageVisitor = std::function<void(std::int64_t receive_time_ns, const std::vector<std::uint8_t>& bytes)>;
 
 class BagFile {
  public:
@@ -44,8 +43,8 @@ class BagFile {
   // Refuses a topic whose connections are not of `type` (datatype and md5sum), naming the topic,
   // the expected and the found type.
   void check_type(const std::string& topic, const MessageType& type) const;
-  // All messages of `topic` in bag time order.
-  std::vector<RawMessage> messages(const std::string& topic) const;
+  // Every message of `topic` in bag time order, one at a time (a long bag is never held whole).
+  void for_each_message(const std::string& topic, const MessageVisitor& visit) const;
 
  private:
   struct Impl;

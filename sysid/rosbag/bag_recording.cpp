@@ -35,17 +35,16 @@ std::string base_name(const std::string& path) {
 template <class M>
 std::vector<std::pair<std::int64_t, M>> decode_topic(const BagFile& bag, const std::string& topic,
                                               M (*decode)(const std::vector<std::uint8_t>&, const std::string&)) {
-  const std::vector<RawMessage> raw = bag.messages(topic);
   std::vector<std::pair<std::int64_t, M>> out;
-  out.reserve(raw.size());
+  std::vector<std::int64_t> receive_ns;
   bool stamped = true;
-  for (std::size_t i = 0; i < raw.size(); ++i) {
-    M m = decode(raw[i].bytes, bag.path() + ": topic '" + topic + "' message " + std::to_string(i + 1));
+  bag.for_each_message(topic, [&](std::int64_t received, const std::vector<std::uint8_t>& bytes) {
+    M m = decode(bytes, bag.path() + ": topic '" + topic + "' message " + std::to_string(out.size() + 1));
     if (m.header.stamp_ns <= 0) stamped = false;
+    receive_ns.push_back(received);
     out.emplace_back(0, std::move(m));
-  }
-  for (std::size_t i = 0; i < raw.size(); ++i)
-    out[i].first = stamped ? out[i].second.header.stamp_ns : raw[i].receive_time_ns;
+  });
+  for (std::size_t i = 0; i < out.size(); ++i) out[i].first = stamped ? out[i].second.header.stamp_ns : receive_ns[i];
   std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   // Keep strictly increasing times (a repeated stamp keeps its last message).
   std::vector<std::pair<std::int64_t, M>> unique;
