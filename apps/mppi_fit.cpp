@@ -4,6 +4,7 @@
 
 #include "cli/app.hpp"
 #include "cli/options.hpp"
+#include "mppi_fit_bag.hpp"
 #include "mppi_fit_commands.hpp"
 
 int FitCommands::run() const {
@@ -37,6 +38,7 @@ int main(int argc, char** argv) {
   // (the command is required by FitCommands::run, so that an unknown flag is named first)
   std::string data_dir;
   mppi::cli::add_data_dir_option(app, data_dir);  // before the command: mppi-fit --data-dir DIR estimate ...
+  register_bag_reader();  // a recording may be a rosbag (docs/ROSBAG.md)
   FitCommands commands;
   add_estimate_command(app, commands);
   add_convert_command(app, commands);

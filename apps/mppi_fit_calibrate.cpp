@@ -19,6 +19,7 @@
 #include "dynamics/model_registry.hpp"
 #include "dynamics/vehicle_params.hpp"
 #include "mppi/vehicle_state.hpp"
+#include "mppi_fit_bag.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"
 #include "sysid/manoeuvre_rollout.hpp"
@@ -51,6 +52,9 @@ const char* kCalibrateUsage = R"(usage: mppi-fit calibrate [options]
                        a run whose car was put back (a crash or stall) should be cut
                        there first: the log does not mark the jump
   --heldout-log FILE   also judge on this recording (a second table, fit_logs.md); repeatable
+                       (a --train-log / --heldout-log may be a rosbag, FILE.bag: docs/ROSBAG.md)
+  --topic-map FILE     rosbag logs: which topics hold the drive (YAML, docs/ROSBAG.md)
+  --topic K=V[,K=V]    rosbag logs: over the topic map, e.g. pose=/odom
   --dither S,T         white noise (std) added to every steering / throttle
                        command of both sequences, as MPPI's applied commands
                        carry its exploration noise                          (0,0)
@@ -191,6 +195,10 @@ int mppi_fit_calibrate(int argc, char** argv) {
         train_opt.seed = static_cast<std::uint64_t>(s);
       } else if (a == "--train-log") {
         train_logs.push_back(value());
+      } else if (a == "--topic-map") {
+        fit_bag_options().topic_map_file = value();
+      } else if (a == "--topic") {
+        fit_bag_options().topics.push_back(value());
       } else if (a == "--heldout-log") {
         heldout_logs.push_back(value());
       } else if (a == "--dither") {

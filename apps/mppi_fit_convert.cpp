@@ -1,4 +1,4 @@
-// mppi-fit convert: a shipped real recording (DART JetRacer, ETH RC car) -> the project's
+// mppi-fit convert: a shipped real recording (DART JetRacer, ETH RC car) or a rosbag -> the project's
 // recording format (docs/RECORDING_FORMAT.md). Conventions: sysid/real_data.hpp.
 #include <cstdio>
 #include <memory>
@@ -7,6 +7,7 @@
 #include "base/error.hpp"
 #include "cli/app.hpp"
 #include "cli/options.hpp"
+#include "mppi_fit_bag.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"
 #include "sysid/real_data.hpp"
@@ -41,7 +42,9 @@ int run_convert(ConvertArgs& args) {
       input = z == std::string::npos ? mppi::sim::data_file(input)
                                      : mppi::sim::data_file(input.substr(0, z + 4)) + input.substr(z + 4);
     }
-    const mppi::sim::Recording rec = mppi::sysid::convert_real_file(input, s);
+    const bool bag = input.size() > 4 && input.compare(input.size() - 4, 4, ".bag") == 0;
+    const mppi::sim::Recording rec =
+        bag ? mppi::sysid::load_any_recording(input) : mppi::sysid::convert_real_file(input, s);
     const auto& t = rec.column("t");
     std::printf("%s: %zu rows, %.2f s, vehicle %s\n", input.c_str(), rec.rows(),
                 rec.rows() ? t.back() - t.front() : 0.0, rec.metadata.at("vehicle").c_str());
@@ -64,8 +67,8 @@ void add_convert_command(CLI::App& fit, FitCommands& commands) {
       fit.add_subcommand("convert", "convert a shipped real-data recording into the project's recording format");
   cmd->add_option("input", args->input,
                   "a raw CSV, or ARCHIVE.zip:MEMBER.csv (e.g. the shipped "
-                  "data/real/dart_jetracer.zip:car_1_Datarecording_09_16_2024_10_27_02.csv); a name starting with "
-                  "\"real/\" is looked up in the data folder")
+                  "data/real/dart_jetracer.zip:car_1_Datarecording_09_16_2024_10_27_02.csv), or a rosbag FILE.bag "
+                  "(docs/ROSBAG.md); a name starting with \"real/\" is looked up in the data folder")
       ->type_name("INPUT");
   cmd->add_option("--out", args->out, "output recording (default: stdout summary only, nothing written)")
       ->type_name("FILE");
@@ -75,6 +78,7 @@ void add_convert_command(CLI::App& fit, FitCommands& commands) {
   cmd->add_option("--smoothing", args->settings.smoothing_half_window,
                   "DART: samples each side of the Vicon pose fit (10 = +-0.1 s)")
       ->type_name("N");
+  add_bag_options(cmd);
   cmd->add_option("--list", args->list_archive, "list the members of a zip archive and exit")->type_name("ARCHIVE");
   commands.add(cmd, [args] { return run_convert(*args); });
 }

@@ -22,6 +22,7 @@
 #include "dynamics/effects.hpp"
 #include "base/error.hpp"
 #include "dynamics/model_registry.hpp"
+#include "mppi_fit_bag.hpp"
 #include "mppi_fit_commands.hpp"
 #include "diagnose/diagnose.hpp"
 #include "diagnose/sweep.hpp"
@@ -344,7 +345,8 @@ void add_stability_options(CLI::App& cmd, SelectionOptions& selection) {
 void add_diagnose_options(CLI::App& cmd, DiagnoseArgs& a) {
   cmd.add_option("--log", a.logs,
                  "recording (docs/RECORDING_FORMAT.md), or a real recording (DART / ETH CSV, or "
-                 "ARCHIVE.zip:MEMBER.csv), converted on the fly (sysid/real_data.hpp); repeat to fit several jointly")
+                 "ARCHIVE.zip:MEMBER.csv), or a rosbag FILE.bag (docs/ROSBAG.md), converted on the fly "
+                 "(sysid/real_data.hpp); repeat to fit several jointly")
       ->type_name("FILE");
   mppi::cli::add_model_option(cmd, "--model", a.model, "nominal model", nominal_models());
   cmd.add_option("--params", a.params,
@@ -435,6 +437,7 @@ void add_diagnose_command(CLI::App& fit, FitCommands& commands) {
   diag->footer(effect_ids_help());
   auto diagnose = std::make_shared<DiagnoseArgs>();
   add_diagnose_options(*diag, *diagnose);
+  add_bag_options(diag);
   commands.add(diag, guarded(diagnose, &cmd_diagnose));
 
   auto synth = std::make_shared<SynthArgs>();

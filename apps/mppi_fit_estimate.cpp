@@ -17,6 +17,7 @@
 #include "dynamics/vehicle_params.hpp"
 #include "dynamics/model_registry.hpp"
 #include "base/error.hpp"
+#include "mppi_fit_bag.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"
 #include "sysid/estimation_plots.hpp"
@@ -384,8 +385,9 @@ void add_estimate_command(CLI::App& fit, FitCommands& commands) {
       "estimate", "estimate model parameters from a recording (UKF, joint UKF, ALM-UKF); docs/ESTIMATION.md");
   cmd->add_option("recording", args->input,
                   "a recording (docs/RECORDING_FORMAT.md), or a shipped raw one converted on the fly: "
-                  "real/dart_jetracer.zip:<member>.csv (see mppi-fit convert --list)")
+                  "real/dart_jetracer.zip:<member>.csv (see mppi-fit convert --list), or a rosbag FILE.bag (docs/ROSBAG.md)")
       ->type_name("RECORDING");
+  add_bag_options(cmd);
   mppi::cli::add_model_option(*cmd, "--model", args->model, "model", estimable_models());
   cmd->add_option("--params", args->params_file,
                   "base parameters (YAML of that model, keys in --list-params; default "

@@ -16,6 +16,7 @@ MPPI_DEBIAN_PACKAGES=(
   # ROS 1 (Debian's packages) for the nodes in ros/ (docs/ROS.md); the build goes on without them.
   ros-core-dev catkin ros-message-generation ros-std-msgs ros-geometry-msgs ros-nav-msgs
   python3-rospy python3-rosbag librosbag-dev
+  python3-genpy python3-nav-msgs python3-geometry-msgs
 )
 
 mppi_missing_packages() {

@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 
 #include "base/error.hpp"
+#include "sysid/real_data.hpp"
 
 namespace mppi::sysid {
 
@@ -228,7 +229,11 @@ sim::Recording join_recordings(const std::vector<sim::Recording>& pieces, double
 }
 
 sim::Recording read_learned_model_log(const std::string& path) {
-  sim::Recording rec = sim::RecordingReader::read(path);
+  // A rosbag goes through the registered reader (load_any_recording); other files are read as the
+  // project's format.
+  sim::Recording rec = path.size() > 4 && path.compare(path.size() - 4, 4, ".bag") == 0
+                           ? load_any_recording(path)
+                           : sim::RecordingReader::read(path);
   if (rec.has_column("applied_steer") && rec.has_column("applied_throttle")) {
     const std::vector<double> steer = rec.column("applied_steer"), throttle = rec.column("applied_throttle");
     for (std::size_t c = 0; c < rec.columns.size(); ++c) {

@@ -370,7 +370,32 @@ sim::Recording convert_real_file(const std::string& spec, const RealConvertSetti
   return rec;
 }
 
+namespace {
+std::vector<std::pair<std::string, RecordingFileReader>>& file_readers() {
+  static std::vector<std::pair<std::string, RecordingFileReader>> readers;
+  return readers;
+}
+bool has_ending(const std::string& s, const std::string& ending) {
+  return s.size() >= ending.size() && s.compare(s.size() - ending.size(), ending.size(), ending) == 0;
+}
+}  // namespace
+
+void register_recording_reader(const std::string& extension, RecordingFileReader reader) {
+  if (extension.empty() || !reader) throw Error("register_recording_reader: an extension and a reader are needed");
+  for (auto& r : file_readers())
+    if (r.first == extension) {
+      r.second = std::move(reader);
+      return;
+    }
+  file_readers().emplace_back(extension, std::move(reader));
+}
+
 sim::Recording load_any_recording(const std::string& spec) {
+  for (const auto& [extension, reader] : file_readers())
+    if (has_ending(spec, extension)) return reader(spec);
+  if (has_ending(spec, ".bag"))
+    throw Error(spec + ": a rosbag, and this build reads no rosbags (configure with librosbag-dev installed and "
+                       "MPPI_WITH_ROSBAG=ON; docs/ROSBAG.md)");
   const std::string text = read_text_or_zip_member(spec);
   std::istringstream in(text);
   std::string line;

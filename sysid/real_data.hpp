@@ -20,6 +20,7 @@
 //   t = t_nominal_s (uniform 1/30 s: the source stored no timestamps), x, y = x_m, y_m,
 //   yaw = unwrapped theta_rad, (vx, vy) = world velocity rotated by -yaw, yaw_rate = omega_radps
 //   with |omega| > 20 rad/s glitches set missing, steer/throttle = steer_cmd/throttle_cmd.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -54,7 +55,15 @@ sim::Recording convert_real_file(const std::string& spec, const RealConvertSetti
 
 // A recording in the project format, or a raw shipped recording converted on the fly
 // (recognised by its header); `spec` as for convert_real_file. Errors name file, line, column.
+// A file whose name ends in an extension given to register_recording_reader is read by that
+// reader; a ".bag" with no reader registered is refused, saying the build has no rosbag support.
 sim::Recording load_any_recording(const std::string& spec);
+
+// Readers for recordings in containers this library does not parse itself (a rosbag, read by
+// sysid/rosbag/ where the build has librosbag), chosen by the file name's ending (e.g. ".bag").
+// A program registers them at start-up; a later registration for the same ending replaces it.
+using RecordingFileReader = std::function<sim::Recording(const std::string& path)>;
+void register_recording_reader(const std::string& extension, RecordingFileReader reader);
 
 // Writes a Recording (any columns; required ones first as in the reader) to `path` in the
 // project format, metadata lines included. Throws mppi::Error if it cannot be written.

@@ -129,3 +129,25 @@ TEST_CASE("a converted recording round-trips through the project's writer and re
     }
   CHECK(back.metadata.at("vehicle") == "eth_lasgroup_rccar");
 }
+
+TEST_CASE("a registered reader reads its files; a rosbag without one is refused saying so", "[sysid][real]") {
+  // Nothing in this program registers a ".bag" reader (mppi-fit does, where librosbag is built).
+  CHECK(error_of([] { load_any_recording("run.bag"); }) ==
+        "run.bag: a rosbag, and this build reads no rosbags (configure with librosbag-dev installed and "
+        "MPPI_WITH_ROSBAG=ON; docs/ROSBAG.md)");
+  std::string seen;
+  register_recording_reader(".testrec", [&seen](const std::string& path) {
+    seen = path;
+    sim::Recording r;
+    r.metadata["source"] = "test reader";
+    return r;
+  });
+  CHECK(load_any_recording("a/b.testrec").metadata.at("source") == "test reader");
+  CHECK(seen == "a/b.testrec");
+  register_recording_reader(".testrec", [](const std::string& path) -> sim::Recording {
+    throw Error(path + ": the second reader");
+  });  // replaces the first
+  CHECK(error_of([] { load_any_recording("c.testrec"); }) == "c.testrec: the second reader");
+  CHECK(error_of([] { register_recording_reader("", {}); }) ==
+        "register_recording_reader: an extension and a reader are needed");
+}
