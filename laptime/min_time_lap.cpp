@@ -183,7 +183,7 @@ MinTimeLap min_time_lap(const sim::Track& track, const SingleTrackParams& vehicl
   app->Options()->SetNumericValue("acceptable_dual_inf_tol", 1e-2);
   app->Options()->SetNumericValue("acceptable_constr_viol_tol", options.max_defect);
   app->Options()->SetNumericValue("acceptable_obj_change_tol", 1e-6);
-  app->Options()->SetIntegerValue("acceptable_iter", 10);
+  app->Options()->SetIntegerValue("acceptable_iter", 5);
   if (app->Initialize() != Ipopt::Solve_Succeeded) throw Error("min_time_lap: IPOPT failed to initialise");
   const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(GetRawPtr(nlp)));
 

@@ -30,7 +30,7 @@ namespace mppi::laptime {
 struct MinTimeLapOptions {
   double car_half_width_m = 0.3;    // as sim::LimitLapOptions: the centre of gravity keeps
   double safety_margin_m = 0.2;     // half the car's width plus this from both boundaries
-  double station_spacing_m = 0.25;  // collocation stations along the centreline [m]
+  double station_spacing_m = 0.5;   // collocation stations along the centreline [m]
   // Added to the lap time [s per (command unit)^2 per station]: damps the chattering of the
   // commands between stations that the lap time alone leaves free; small enough to move the lap
   // by well under a millisecond.
