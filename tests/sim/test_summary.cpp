@@ -47,6 +47,7 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.laps_completed = 2;
   s.lap_times_s = {12.5, 11.75};
   s.limit_lap_s = 6.25;
+  s.limit_lap_method = "collocation";
   s.lap_time_ratio = {2.0, 1.88};
   s.crashes = 1;
   s.crash_reasons = {"hit the outer barrier at (1.00, 2.00)"};
@@ -69,7 +70,9 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.mean_abs_steer_step = 0.0625;
   s.mean_abs_throttle_step = 0.03125;
   const auto j = nlohmann::json::parse(to_json(s));
-  CHECK(j.size() == 37);
+  CHECK(j.size() == 38);
+  CHECK(j.at("limit_lap_method") == "collocation");
+  CHECK(nlohmann::json::parse(to_json(RunSummary{})).at("limit_lap_method").is_null());
   CHECK(j.at("variant") == "tube");
   CHECK(j.at("nominal_resets") == 7);
   CHECK(j.at("sampler") == "smooth");

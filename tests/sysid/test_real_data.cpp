@@ -130,7 +130,7 @@ TEST_CASE("a converted recording round-trips through the project's writer and re
   CHECK(back.metadata.at("vehicle") == "eth_lasgroup_rccar");
 }
 
-TEST_CASE("a registered reader reads its files; a rosbag without one is refused saying so", "[sysid][real]") {
+TEST_CASE("a registered reader reads its files, and a rosbag without one is refused saying so", "[sysid][real]") {
   // Nothing in this program registers a ".bag" reader (mppi-fit does, where librosbag is built).
   CHECK(error_of([] { load_any_recording("run.bag"); }) ==
         "run.bag: a rosbag, and this build reads no rosbags (configure with librosbag-dev installed and "
