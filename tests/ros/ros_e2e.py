@@ -26,6 +26,7 @@
                                         `mppi-fit diagnose --log x.bag` against the simulator's own
                                         plant: matched, no effect named; with steering_delay_s 0.08,
                                         the steering delay named, its estimate in [0.05, 0.12] s
+                                        (--stability-resamples N: the diagnosis' stability selection)
 
 Prints the figures and PASS, or FAIL with the reason (exit 1). Python 3 standard library only.
 """
@@ -410,11 +411,11 @@ DRIVE_S = 30.0
 DELAY_S = 0.08
 
 
-def diagnose_bag(fit_bin, bag, out):
+def diagnose_bag(fit_bin, bag, out, resamples):
     t0 = time.time()
     d = subprocess.run([os.path.join(fit_bin, 'mppi-fit'), 'diagnose', '--log', bag, '--model', 'single-track',
                         '--params', PLANT_PARAMS, *BAG_READING, '--no-plots', '--quiet',
-                        '--stability-resamples', '0', '--max-effects', '2', '--out', out],
+                        '--stability-resamples', str(resamples), '--max-effects', '2', '--out', out],
                        capture_output=True, text=True, timeout=600)
     if d.returncode != 0:
         raise RuntimeError('mppi-fit diagnose %s failed (exit %d): %s' % (bag, d.returncode, d.stderr[-800:]))
@@ -422,7 +423,7 @@ def diagnose_bag(fit_bin, bag, out):
         return json.load(f), time.time() - t0
 
 
-def run_diagnose(bin_dir, fit_bin, scratch):
+def run_diagnose(bin_dir, fit_bin, scratch, resamples):
     failures = []
     for name, delay in (('matched', 0.0), ('delayed', DELAY_S)):
         t0 = time.time()
@@ -430,7 +431,7 @@ def run_diagnose(bin_dir, fit_bin, scratch):
                                     ['_max_time_s:=%g' % DRIVE_S, '_steering_delay_s:=%g' % delay, *FAST_ACTUATORS],
                                     DRIVE_S + 40)
         t_drive = time.time() - t0
-        report, t_diag = diagnose_bag(fit_bin, bag, os.path.join(scratch, name + '_diagnosis'))
+        report, t_diag = diagnose_bag(fit_bin, bag, os.path.join(scratch, name + '_diagnosis'), resamples)
         selected = report['selected']
         params = report['final_params']
         rmse = report['heldout_1s_normalized_rmse']
@@ -467,6 +468,8 @@ def main():
     ap.add_argument('--sim-bin', help='folder of mppi-sim (laps; default: --bin)')
     ap.add_argument('--probe-bin', help='folder of mppi-ros-safety-probe (safety; default: --bin)')
     ap.add_argument('--fit-bin', help='folder of mppi-fit (record, diagnose; default: --bin)')
+    ap.add_argument('--stability-resamples', type=int, default=0,
+                    help='diagnose: mppi-fit diagnose\'s stability resamples (0: off, as rosbag.end_to_end)')
     ap.add_argument('--keep', help='keep the logs in this folder')
     args = ap.parse_args()
     scratch = args.keep or tempfile.mkdtemp(prefix='mppi_ros_e2e_')
@@ -479,7 +482,7 @@ def main():
         elif args.mode == 'record':
             why = run_record(args.bin, args.fit_bin or args.bin, scratch)
         elif args.mode == 'diagnose':
-            why = run_diagnose(args.bin, args.fit_bin or args.bin, scratch)
+            why = run_diagnose(args.bin, args.fit_bin or args.bin, scratch, args.stability_resamples)
         else:
             why = run_launch(args.bin, scratch)
     except Exception as e:  # a test harness: any failure is reported, never a traceback alone
