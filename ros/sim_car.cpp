@@ -23,6 +23,8 @@ sim::ActuatorLimits limits_of(const SimCarSettings& s) {
   sim::ActuatorLimits a;
   a.steer_delay_s = static_cast<float>(s.steering_delay_s);
   a.throttle_delay_s = static_cast<float>(s.throttle_delay_s);
+  a.steer_rate_per_s = static_cast<float>(s.steering_rate_per_s);
+  a.throttle_rate_per_s = static_cast<float>(s.throttle_rate_per_s);
   return a;
 }
 
@@ -45,6 +47,8 @@ bool SimCarSettings::is_valid(std::string* why) const {
   if (!(plant_dt_s > 0.0 && plant_dt_s <= 0.02)) return fail("plant_dt_s must be in (0, 0.02]");
   if (!(steering_delay_s >= 0.0 && steering_delay_s < 10.0)) return fail("steering_delay_s must be in [0, 10)");
   if (!(throttle_delay_s >= 0.0 && throttle_delay_s < 10.0)) return fail("throttle_delay_s must be in [0, 10)");
+  if (!(steering_rate_per_s > 0.0 && steering_rate_per_s <= 1e6)) return fail("steering_rate_per_s must be in (0, 1e6]");
+  if (!(throttle_rate_per_s > 0.0 && throttle_rate_per_s <= 1e6)) return fail("throttle_rate_per_s must be in (0, 1e6]");
   return true;
 }
 

@@ -19,6 +19,10 @@ struct SimCarSettings {
   double plant_dt_s = 0.002;         // integration step
   double steering_delay_s = 0.0;     // pure transport delay of the steering command
   double throttle_delay_s = 0.0;     // and of the throttle command
+  // The actuators' rate limits [1/s] (sim::ActuatorLimits' defaults: a servo needs 0.4 s lock to
+  // lock); a large value (1e4) makes them act at once, as the diagnosis' nominal models do.
+  double steering_rate_per_s = 5.0;
+  double throttle_rate_per_s = 10.0;
 
   bool is_valid(std::string* why) const;
 };

@@ -1,6 +1,7 @@
 // mppi_sim_node: the built-in simulator as a ROS 1 node. The single-track car on a built-in
 // track, behind the simulated chassis (priorities, runstop, watchdog, calibration) and
-// rate-limited actuators with optional pure delays (~steering_delay_s, ~throttle_delay_s),
+// rate-limited actuators (~steering_rate_per_s, ~throttle_rate_per_s) with optional pure delays
+// (~steering_delay_s, ~throttle_delay_s),
 // integrated in real time. Publishes /pose_estimate (nav_msgs/Odometry, AutoRally's convention:
 // world-frame twist) and chassisState at ~rate_hz; drives on chassisCommand, stops on runstop.
 // The car waits at the start line until the first command that asks for motion; laps are timed
@@ -57,6 +58,8 @@ int main(int argc, char** argv) {
     read_param(nh, "plant_dt_s", settings.plant_dt_s);
     read_param(nh, "steering_delay_s", settings.steering_delay_s);
     read_param(nh, "throttle_delay_s", settings.throttle_delay_s);
+    read_param(nh, "steering_rate_per_s", settings.steering_rate_per_s);
+    read_param(nh, "throttle_rate_per_s", settings.throttle_rate_per_s);
     read_param(nh, "rate_hz", rate_hz);
     read_param(nh, "integration_hz", integration_hz);
     read_param(nh, "laps", laps);

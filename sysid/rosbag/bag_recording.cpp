@@ -211,16 +211,17 @@ sim::Recording read_bag_recording(const std::string& path, const BagTopicMap& ma
         PITCH[k] = lerp(a.pitch, b.pitch);
       }
     }
-    const long c = last_at_or_before(ctl, t);
-    if (c >= 0 && t - ctl[c].t <= map.max_command_age_s) {
+    const double tc = t + map.command_lead_s;  // the controls' time (BagTopicMap::command_lead_s)
+    const long c = last_at_or_before(ctl, tc);
+    if (c >= 0 && tc - ctl[c].t <= map.max_command_age_s) {
       STEER[k] = ctl[c].steer;
       THROTTLE[k] = ctl[c].throttle;
       BRAKE[k] = ctl[c].front_brake;
       if (from_state) col("runstop_motion_enabled")[k] = ctl[c].runstop;
     }
     if (from_state) {
-      const long m = last_at_or_before(cmd, t);
-      if (m >= 0 && t - cmd[m].t <= map.max_command_age_s) {
+      const long m = last_at_or_before(cmd, tc);
+      if (m >= 0 && tc - cmd[m].t <= map.max_command_age_s) {
         col("command_steer")[k] = cmd[m].steer;
         col("command_throttle")[k] = cmd[m].throttle;
       }

@@ -31,7 +31,7 @@ std::string trimmed(const std::string& s) {
 
 std::vector<std::string> topic_map_keys() {
   return {"pose",     "chassis_state", "command",        "wheel_speeds",       "controls", "twist_frame",
-          "steer_sign", "rate_hz",     "max_pose_gap_s", "max_command_age_s", "vehicle"};
+          "steer_sign", "rate_hz",     "max_pose_gap_s", "max_command_age_s", "command_lead_s", "vehicle"};
 }
 
 void BagTopicMap::set(const std::string& key, const std::string& value, const std::string& where) {
@@ -58,6 +58,11 @@ void BagTopicMap::set(const std::string& key, const std::string& value, const st
       throw Error(where + ": topic map key '" + key + "': expected a positive number" +
                   (key == "rate_hz" ? " (or 0: the pose rate)" : "") + ", got '" + value + "'");
     (key == "rate_hz" ? rate_hz : key == "max_pose_gap_s" ? max_pose_gap_s : max_command_age_s) = v;
+  } else if (key == "command_lead_s") {
+    const double v = number(key, value, where);
+    if (!(v >= 0 && v < 1))
+      throw Error(where + ": topic map key 'command_lead_s': expected a number in [0, 1), got '" + value + "'");
+    command_lead_s = v;
   } else {
     std::string known;
     for (const auto& k : topic_map_keys()) known += (known.empty() ? "" : ", ") + k;
@@ -101,6 +106,7 @@ std::string BagTopicMap::describe() const {
   o << "pose=" << pose << ",chassis_state=" << chassis_state << ",command=" << command
     << ",wheel_speeds=" << wheel_speeds << ",controls=" << controls << ",twist_frame=" << twist_frame
     << ",steer_sign=" << steer_sign;
+  if (command_lead_s > 0) o << ",command_lead_s=" << command_lead_s;
   return o.str();
 }
 

@@ -22,6 +22,11 @@ struct BagTopicMap {
   double rate_hz = 0;      // grid of the recording; 0 = the pose topic's median rate, rounded
   double max_pose_gap_s = 0.1;    // pose samples further apart than this leave the rows between missing
   double max_command_age_s = 0.5; // a command older than this leaves steer / throttle missing
+  // Row k holds the latest control message at or before t_k + command_lead_s. 0: the command in
+  // force at t_k. A controller that answers each pose within a few ms (stamping its command when it
+  // sends it) has sent its answer to pose k just after t_k; with a lead of half a row that answer is
+  // row k's, the command acting over (t_k, t_k+1] as the diagnosis reads it.
+  double command_lead_s = 0.0;
   std::string vehicle = "autorally";  // the recording's `vehicle` metadata
 
   // Throws mppi::Error naming `where` and the key for an unknown key or a bad value.

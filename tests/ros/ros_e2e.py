@@ -16,10 +16,23 @@
                                         operator page's runstop (when the page is built) in the
                                         node's pathIntegralStatus
 
+    ros_e2e.py record --bin BUILD/ros/bin --fit-bin BUILD/bin
+                                        the loop (one lap) recorded by `rosbag record`, read back by
+                                        `mppi-fit convert`: the bag's drive against the simulator's
+                                        own summary (lap time, the lap closed, 50 Hz without gaps,
+                                        the twist against the positions, the steering's sign)
+    ros_e2e.py diagnose --bin BUILD/ros/bin --fit-bin BUILD/bin
+                                        two 30-s drives recorded by `rosbag record` and diagnosed by
+                                        `mppi-fit diagnose --log x.bag` against the simulator's own
+                                        plant: matched, no effect named; with steering_delay_s 0.08,
+                                        the steering delay named, its estimate in [0.05, 0.12] s
+                                        (--stability-resamples N: the diagnosis' stability selection)
+
 Prints the figures and PASS, or FAIL with the reason (exit 1). Python 3 standard library only.
 """
 import argparse
 import json
+import math
 import os
 import re
 import urllib.error
@@ -31,6 +44,8 @@ import sys
 import tempfile
 import time
 import xmlrpc.client
+
+SOURCE_DIR = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
 
 # The closed-loop settings: a modest K and T, as the simulator's own closed-loop tests use.
 SPEED_MPS = 6.0
@@ -254,12 +269,207 @@ def run_launch(bin_dir, scratch):
     return '; '.join(failures)
 
 
+# ---- rosbag record -> mppi-fit ----------------------------------------------------------------
+# AutoRally's topics as its own bags hold them (docs/ROSBAG.md); the loop publishes no wheel speeds.
+BAG_TOPICS = ['/pose_estimate', '/chassisState', '/chassisCommand']
+# How mppi-fit reads these bags. The nodes carry the library's steering sign (+1 turns left) in
+# chassisCommand / chassisState; the simulator's chassisState reports the actuators' positions
+# (after the steering delay and the rate limits), so the controls are the controller's commands;
+# and the controller answers each pose within a few ms, its command stamped when sent, so the
+# answer to pose k is row k's (command_lead_s: half a row; without it every command is read one
+# row late and the diagnosis sees a time offset of about -0.02 s).
+BAG_READING = ['--topic', 'steer_sign=1,controls=command,command_lead_s=0.01']
+# The simulator's plant as the diagnosis' nominal: mppi_sim_node's single-track parameters, and its
+# actuators acting at once (the nominal models have no rate limits; sim::ActuatorLimits' default
+# 5 /s would be a steer_rate_limit the diagnosis names, rightly).
+PLANT_PARAMS = os.path.join(SOURCE_DIR, 'data', 'config', 'autorally_single_track.yaml')
+FAST_ACTUATORS = ['_steering_rate_per_s:=10000', '_throttle_rate_per_s:=10000']
+
+
+def wait_for_subscriber(env, topic, node_prefix, timeout_s=20):
+    master = xmlrpc.client.ServerProxy(env['ROS_MASTER_URI'])
+    deadline = time.time() + timeout_s
+    while time.time() < deadline:
+        _, _, (_, subscribers, _) = master.getSystemState('/ros_e2e')
+        for name, nodes in subscribers:
+            if name == topic and any(n.startswith(node_prefix) for n in nodes):
+                return True
+        time.sleep(0.2)
+    return False
+
+
+def record_drive(bin_dir, scratch, name, sim_params, sim_timeout_s):
+    """The loop on its own roscore, recorded by `rosbag record`; returns (bag, summary) or raises."""
+    bag = os.path.join(scratch, name + '.bag')
+    summary_file = os.path.join(scratch, name + '_summary.json')
+    stats_file = os.path.join(scratch, name + '_controller_stats.json')
+    with RosMaster(scratch) as ros:
+        recorder = start(['rosbag', 'record', '--tcpnodelay', '-O', bag, *BAG_TOPICS], ros.env,
+                         os.path.join(scratch, name + '_rosbag.log'))
+        controller = simulator = None
+        try:
+            # rosbag record subscribes before anything is published, so the bag holds the whole drive
+            if not wait_for_subscriber(ros.env, '/chassisCommand', '/record'):
+                raise RuntimeError('rosbag record did not subscribe:\n' + tail(os.path.join(scratch, name + '_rosbag.log')))
+            controller = start(controller_cmd(bin_dir, stats_file), ros.env, os.path.join(scratch, name + '_controller.log'))
+            simulator = start([os.path.join(bin_dir, 'mppi_sim_node'), '_rate_hz:=%g' % HZ,
+                               '_summary_file:=' + summary_file, *sim_params],
+                              ros.env, os.path.join(scratch, name + '_sim.log'))
+            try:
+                simulator.wait(timeout=sim_timeout_s)
+            except subprocess.TimeoutExpired:
+                stop(simulator, 5)
+        finally:
+            # SIGINT: rosbag record closes and indexes the bag (x.bag.active -> x.bag)
+            stop(recorder, 20)
+            stop(controller, 10)
+            stop(simulator, 5)
+    if not os.path.exists(summary_file):
+        raise RuntimeError('no summary from mppi_sim_node:\n' + tail(os.path.join(scratch, name + '_sim.log')))
+    if not os.path.exists(bag):
+        raise RuntimeError('rosbag record left no closed bag:\n' + tail(os.path.join(scratch, name + '_rosbag.log')))
+    with open(summary_file) as f:
+        return bag, json.load(f)
+
+
+def read_recording(path):
+    """A recording CSV (docs/RECORDING_FORMAT.md) -> {column: [float or None]}."""
+    with open(path) as f:
+        lines = [line.rstrip('\n') for line in f if not line.startswith('#')]
+    header = lines[0].split(',')
+    cols = {h: [] for h in header}
+    for line in lines[1:]:
+        for h, v in zip(header, line.split(',')):
+            cols[h].append(float(v) if v != '' else None)
+    return cols
+
+
+def run_record(bin_dir, fit_bin, scratch):
+    t_start = time.time()
+    bag, summary = record_drive(bin_dir, scratch, 'lap', ['_laps:=1', '_max_time_s:=40'], 60)
+    t_drive = time.time() - t_start
+    csv = os.path.join(scratch, 'lap.csv')
+    conv = subprocess.run([os.path.join(fit_bin, 'mppi-fit'), 'convert', bag, '--out', csv, *BAG_READING],
+                          capture_output=True, text=True, timeout=60)
+    if conv.returncode != 0:
+        return 'mppi-fit convert failed: ' + conv.stderr[-800:]
+    print(conv.stdout.strip())
+    info = subprocess.run(['rosbag', 'info', bag], capture_output=True, text=True, timeout=60, env=os.environ)
+    print('\n'.join(line for line in info.stdout.splitlines() if 'msgs' in line or 'duration' in line))
+    r = read_recording(csv)
+    t, x, y, vx, vy = r['t'], r['x'], r['y'], r['vx'], r['vy']
+    n = len(t)
+    failures = []
+    if summary['laps'] != 1 or summary['crashes'] != 0:
+        failures.append('the simulator drove %d laps with %d crashes (want 1, 0)' % (summary['laps'], summary['crashes']))
+    if n < 100:
+        return 'the bag gave %d rows' % n
+    dt = (t[-1] - t[0]) / (n - 1)
+    missing = sum(1 for i in range(n) if x[i] is None or vx[i] is None)
+    speed = [math.hypot(vx[i], vy[i]) if vx[i] is not None else 0.0 for i in range(n)]
+    moving = [i for i in range(n) if speed[i] > 0.05]
+    drive_s = t[moving[-1]] - t[moving[0]] + dt if moving else 0.0
+    lap_s = summary['lap_times_s'][0] if summary['lap_times_s'] else float('nan')
+    first, last = moving[0] if moving else 0, n - 1
+    gap_m = math.hypot(x[last] - x[first], y[last] - y[first])
+    # the twist (world frame in the bag, body frame in the CSV) against the positions' derivative
+    dv = [abs(math.hypot(x[i + 1] - x[i - 1], y[i + 1] - y[i - 1]) / (t[i + 1] - t[i - 1]) - speed[i])
+          for i in range(1, n - 1) if None not in (x[i - 1], x[i + 1])]
+    dv_mean = sum(dv) / len(dv)
+    # the controls: present while the car drives, and steering left turns left
+    ctl = [i for i in moving if r['steer'][i] is not None and r['throttle'][i] is not None]
+    # (the yaw rate follows the steering's recent mean: MPPI's commands are noisy row to row)
+    steer = [v if v is not None else 0.0 for v in r['steer']]
+    smooth = [sum(steer[max(0, i - 24):i + 1]) / len(steer[max(0, i - 24):i + 1]) for i in range(n)]
+    pairs = [(smooth[i], r['yaw_rate'][i]) for i in ctl if r['yaw_rate'][i] is not None]
+    ms = sum(p[0] for p in pairs) / len(pairs)
+    mw = sum(p[1] for p in pairs) / len(pairs)
+    cov = sum((a - ms) * (b - mw) for a, b in pairs)
+    corr = cov / math.sqrt(sum((a - ms) ** 2 for a, _ in pairs) * sum((b - mw) ** 2 for _, b in pairs))
+    print('simulator: 1 lap %.2f s, %d crashes; the bag: %d rows at %.1f Hz, %d without a pose, driving %.2f s, '
+          'lap closed within %.2f m, |speed from positions - twist| mean %.3f m/s, controls on %d of %d driving rows, '
+          'corr(the steering\'s 0.5-s mean, yaw rate) %.2f; drive with recording %.1f s' %
+          (lap_s, summary['crashes'], n, 1.0 / dt, missing, drive_s, gap_m, dv_mean, len(ctl), len(moving), corr, t_drive))
+    if abs(1.0 / dt - HZ) > 0.5:
+        failures.append('rows at %.2f Hz, want %g' % (1.0 / dt, HZ))
+    if missing:
+        failures.append('%d rows without a pose' % missing)
+    if not abs(drive_s - lap_s) <= 0.3:
+        failures.append('the bag drives %.2f s, the simulator timed its lap %.2f s (tolerance 0.3 s)' % (drive_s, lap_s))
+    if gap_m > 2.0:
+        failures.append('the lap does not close in the bag: %.2f m from its start' % gap_m)
+    if dv_mean > 0.1:
+        failures.append('the twist differs from the positions by %.3f m/s on average' % dv_mean)
+    if len(ctl) < 0.95 * len(moving):
+        failures.append('controls on %d of %d driving rows' % (len(ctl), len(moving)))
+    if corr < 0.25:
+        failures.append('the steering\'s 0.5-s mean and the yaw rate correlate %.2f (a steering sign or timing fault)' % corr)
+    return '; '.join(failures)
+
+
+DRIVE_S = 30.0
+DELAY_S = 0.08
+
+
+def diagnose_bag(fit_bin, bag, out, resamples):
+    t0 = time.time()
+    d = subprocess.run([os.path.join(fit_bin, 'mppi-fit'), 'diagnose', '--log', bag, '--model', 'single-track',
+                        '--params', PLANT_PARAMS, *BAG_READING, '--no-plots', '--quiet',
+                        '--stability-resamples', str(resamples), '--max-effects', '2', '--out', out],
+                       capture_output=True, text=True, timeout=600)
+    if d.returncode != 0:
+        raise RuntimeError('mppi-fit diagnose %s failed (exit %d): %s' % (bag, d.returncode, d.stderr[-800:]))
+    with open(os.path.join(out, 'report.json')) as f:
+        return json.load(f), time.time() - t0
+
+
+def run_diagnose(bin_dir, fit_bin, scratch, resamples):
+    failures = []
+    for name, delay in (('matched', 0.0), ('delayed', DELAY_S)):
+        t0 = time.time()
+        bag, summary = record_drive(bin_dir, scratch, name,
+                                    ['_max_time_s:=%g' % DRIVE_S, '_steering_delay_s:=%g' % delay, *FAST_ACTUATORS],
+                                    DRIVE_S + 40)
+        t_drive = time.time() - t0
+        report, t_diag = diagnose_bag(fit_bin, bag, os.path.join(scratch, name + '_diagnosis'), resamples)
+        selected = report['selected']
+        params = report['final_params']
+        rmse = report['heldout_1s_normalized_rmse']
+        print('%s (steering_delay_s %g): %.0f s simulated, %d laps, %d crashes, %d rows; named %s %s; '
+              'suspected %s; verdict: %s; held-out 1-s normalised RMSE %.4f -> %.4f; drive %.1f s, diagnose %.1f s' %
+              (name, delay, summary['sim_time_s'], summary['laps'], summary['crashes'], report['rows'],
+               selected or 'nothing', {k: round(v['value'], 4) for k, v in params.items()} if params else '',
+               [s['id'] for s in report['suspected']] or 'nothing', report['verdict'], rmse['nominal'],
+               rmse['corrected'], t_drive, t_diag))
+        if summary['crashes']:
+            failures.append('%s: %d crashes' % (name, summary['crashes']))
+        if delay == 0.0:
+            if selected:
+                failures.append('matched: named %s' % selected)
+        else:
+            # the steering's delay family; where both forms are named, the mean delay of the chain
+            # (a pure delay d, then a first-order lag tau) is d + tau
+            family = {'steer_delay': 'steer_delay_s', 'steer_lag': 'steer_lag_s'}
+            found = [(e, params[family[e]]['value']) for e in selected if e in family and family[e] in params]
+            total = sum(v for _, v in found)
+            print('delayed: the steering\'s delay estimate %.4f s (%s), true %g s' %
+                  (total, ' + '.join('%s %.4f' % f for f in found) or 'none named', DELAY_S))
+            if not found:
+                failures.append('delayed: no steering delay named (named %s)' % (selected or 'nothing'))
+            elif not 0.05 <= total <= 0.12:
+                failures.append('delayed: steering delay estimate %.4f s, outside [0.05, 0.12]' % total)
+    return '; '.join(failures)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument('mode', choices=['laps', 'safety', 'launch'])
+    ap.add_argument('mode', choices=['laps', 'safety', 'launch', 'record', 'diagnose'])
     ap.add_argument('--bin', required=True, help='folder of mppi_sim_node and mppi_controller_node')
     ap.add_argument('--sim-bin', help='folder of mppi-sim (laps; default: --bin)')
     ap.add_argument('--probe-bin', help='folder of mppi-ros-safety-probe (safety; default: --bin)')
+    ap.add_argument('--fit-bin', help='folder of mppi-fit (record, diagnose; default: --bin)')
+    ap.add_argument('--stability-resamples', type=int, default=0,
+                    help='diagnose: mppi-fit diagnose\'s stability resamples (0: off, as rosbag.end_to_end)')
     ap.add_argument('--keep', help='keep the logs in this folder')
     args = ap.parse_args()
     scratch = args.keep or tempfile.mkdtemp(prefix='mppi_ros_e2e_')
@@ -269,6 +479,10 @@ def main():
             why = run_laps(args.bin, args.sim_bin or args.bin, scratch)
         elif args.mode == 'safety':
             why = run_safety(args.bin, args.probe_bin or args.bin, scratch)
+        elif args.mode == 'record':
+            why = run_record(args.bin, args.fit_bin or args.bin, scratch)
+        elif args.mode == 'diagnose':
+            why = run_diagnose(args.bin, args.fit_bin or args.bin, scratch, args.stability_resamples)
         else:
             why = run_launch(args.bin, scratch)
     except Exception as e:  # a test harness: any failure is reported, never a traceback alone

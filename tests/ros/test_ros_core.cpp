@@ -205,6 +205,22 @@ TEST_CASE("the simulated car waits, drives on commands, and its steering delay h
   CHECK_THROWS_WITH(SimCar(settings), Catch::Contains("plant_dt_s"));
 }
 
+TEST_CASE("the simulated car's steering rate limit: 5 /s by default, at once when raised", "[ros]") {
+  SimCarSettings settings;
+  SimCar limited(settings);
+  limited.command({1.f, 0.f}, 0.0);
+  limited.advance_to(0.02);
+  CHECK(limited.applied().steer == Approx(0.1f).margin(0.011f));  // 5 /s x 0.02 s
+  settings.steering_rate_per_s = settings.throttle_rate_per_s = 1e4;
+  SimCar fast(settings);
+  fast.command({1.f, 0.5f}, 0.0);
+  fast.advance_to(0.02);
+  CHECK(fast.applied().steer == Approx(1.f));
+  CHECK(fast.applied().throttle == Approx(0.5f));
+  settings.steering_rate_per_s = 0.0;
+  CHECK_THROWS_WITH(SimCar(settings), Catch::Contains("steering_rate_per_s"));
+}
+
 TEST_CASE("the simulated car's chassis neutralises the throttle when commands stop (watchdog)", "[ros]") {
   SimCar car(SimCarSettings{});
   car.command({0.f, 0.5f}, 0.0);

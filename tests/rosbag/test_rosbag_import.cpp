@@ -125,6 +125,27 @@ TEST_CASE("rosbag import: resampled to another rate with the controls from the c
   }
 }
 
+TEST_CASE("rosbag import: command_lead_s gives row k the command sent just after t_k", "[rosbag]") {
+  BagTopicMap map;
+  map.apply_pairs("controls=command,command_lead_s=0.01");
+  const mppi::sim::Recording rec = read_bag_recording(bag("circle.bag"), map);
+  CHECK(rec.metadata.at("rosbag_topics").find("command_lead_s=0.01") != std::string::npos);
+  int shifted = 0;
+  for (std::size_t k = 0; k < rec.rows(); ++k) {
+    const double t = rec.column("t")[k];
+    INFO("row " << k << " t " << t);
+    const long c = std::min(held_index(t + 0.01, 0.005), 199L);  // commands at 0.005 + 0.02 j, j < 200
+    if (c < 0) {
+      CHECK(std::isnan(rec.column("throttle")[k]));
+      continue;
+    }
+    CHECK(rec.column("throttle")[k] == Approx(0.1 + 0.001 * c).margin(1e-12));
+    if (c != held_index(t, 0.005)) ++shifted;
+  }
+  CHECK(shifted > 100);  // half the rows take the next command
+  CHECK_THROWS_WITH(map.apply_pairs("command_lead_s=1.5"), Catch::Contains("command_lead_s"));
+}
+
 TEST_CASE("rosbag import: another stack's topics through a topic map file", "[rosbag]") {
   const std::string map_file = bag_dir() + "/other_stack.yaml";
   std::ofstream(map_file) << "pose: /odom\ncommand: cmd\ntwist_frame: body\n";
