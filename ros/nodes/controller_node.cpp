@@ -30,6 +30,7 @@
 #include <std_msgs/Float32MultiArray.h>
 
 #include "base/error.hpp"
+#include "ros/chassis_convention.hpp"
 #include "ros/controller_setup.hpp"
 #include "ros/latency_stats.hpp"
 #include "ros/odometry_state.hpp"
@@ -158,7 +159,7 @@ int main(int argc, char** argv) {
       }, ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   ros::Subscriber state_sub = pub_nh.subscribe<autorally_msgs::chassisState>(
       "chassisState", 1, [&](const autorally_msgs::chassisState::ConstPtr& m) {
-        applied_steer = m->steering;
+        applied_steer = mppi::ros::library_steer_from_chassis(m->steering);
         applied_throttle = m->throttle;
         chassis_motion = static_cast<bool>(m->runstopMotionEnabled);
       });
@@ -179,7 +180,7 @@ int main(int argc, char** argv) {
   bool stopped_sent = false;
 
   auto publish_command = [&](double steering, double throttle) {
-    cmd.steering = steering;
+    cmd.steering = mppi::ros::chassis_steering_from_library(steering);
     cmd.throttle = throttle;
     cmd.frontBrake = -5.0;  // as AutoRally's node: the brake is left to another commander
     cmd.header.stamp = ros::Time::now();

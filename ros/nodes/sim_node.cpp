@@ -27,6 +27,7 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 
+#include "ros/chassis_convention.hpp"
 #include "ros/nodes/ros_messages.hpp"
 #include "ros/sim_car.hpp"
 
@@ -86,7 +87,8 @@ int main(int argc, char** argv) {
       "chassisCommand", 5, [&](const autorally_msgs::chassisCommand::ConstPtr& m) {
         try {
           const std::lock_guard<std::mutex> lock(mutex);
-          command = mppi::Control{static_cast<float>(m->steering), static_cast<float>(m->throttle)};
+          command = mppi::Control{static_cast<float>(mppi::ros::library_steer_from_chassis(m->steering)),
+                                  static_cast<float>(m->throttle)};
         } catch (const std::exception& e) {
           ROS_ERROR_THROTTLE(1.0, "mppi_sim_node: command callback: %s", e.what());
         }
@@ -138,7 +140,7 @@ int main(int argc, char** argv) {
         cs.steeringCommander = car->steering_commander();
         cs.throttleCommander = car->throttle_commander();
         cs.frontBrakeCommander = cs.throttleCommander;
-        cs.steering = car->applied().steer;
+        cs.steering = mppi::ros::chassis_steering_from_library(car->applied().steer);
         cs.throttle = car->applied().throttle;
         cs.frontBrake = 0.0;
         state_pub.publish(cs);

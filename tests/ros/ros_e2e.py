@@ -278,7 +278,7 @@ BAG_TOPICS = ['/pose_estimate', '/chassisState', '/chassisCommand']
 # and the controller answers each pose within a few ms, its command stamped when sent, so the
 # answer to pose k is row k's (command_lead_s: half a row; without it every command is read one
 # row late and the diagnosis sees a time offset of about -0.02 s).
-BAG_READING = ['--topic', 'steer_sign=1,controls=command,command_lead_s=0.01']
+BAG_READING = ['--topic', 'controls=command,command_lead_s=0.01']
 # The simulator's plant as the diagnosis' nominal: mppi_sim_node's single-track parameters, and its
 # actuators acting at once (the nominal models have no rate limits; sim::ActuatorLimits' default
 # 5 /s would be a steer_rate_limit the diagnosis names, rightly).

@@ -18,6 +18,7 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 
+#include "ros/chassis_convention.hpp"
 #include "ros/nodes/ros_messages.hpp"
 #include "ros/sim_car.hpp"
 
@@ -76,7 +77,7 @@ int main(int argc, char** argv) {
       {
         const std::lock_guard<std::mutex> lock(mutex);
         for (; used < received.size(); ++used)
-          car.command({static_cast<float>(received[used].steering), static_cast<float>(received[used].throttle)},
+          car.command({static_cast<float>(mppi::ros::library_steer_from_chassis(received[used].steering)), static_cast<float>(received[used].throttle)},
                       car.time_s());
       }
       car.advance_to(t);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "mppi/controller_options.hpp"
+#include "ros/chassis_convention.hpp"
 #include "ros/controller_setup.hpp"
 #include "ros/latency_stats.hpp"
 #include "ros/odometry_state.hpp"
@@ -228,4 +229,19 @@ TEST_CASE("the simulated car's chassis neutralises the throttle when commands st
   CHECK(car.applied().throttle > 0.f);
   car.advance_to(1.0);  // no command for a second
   CHECK(car.applied().throttle == Approx(0.f).margin(1e-6));
+}
+
+TEST_CASE("AutoRally's chassis steering (+1 right) turns the simulated car the right way", "[ros]") {
+  // A chassis command of -0.5 is half left in AutoRally's convention: the car's yaw must grow
+  // (counter-clockwise), and the applied steering read back onto a chassis message is -0.5 again.
+  SimCarSettings settings;
+  SimCar car(settings);
+  const double yaw0 = car.state().yaw_rad;
+  for (int i = 1; i <= 75; ++i) {
+    car.command({static_cast<float>(library_steer_from_chassis(-0.5)), 0.4f}, car.time_s());
+    car.advance_to(0.02 * i);
+  }
+  CHECK(car.state().yaw_rad - yaw0 > 0.1);
+  CHECK(chassis_steering_from_library(car.applied().steer) == Approx(-0.5));
+  CHECK(library_steer_from_chassis(chassis_steering_from_library(0.25)) == 0.25);
 }
