@@ -35,6 +35,7 @@
 #include "dynamics/models/single_track_model.hpp"
 #include "mppi/controller.hpp"
 #include "mppi/cost_map.hpp"
+#include "sim/centreline_pose.hpp"
 #include "sim/crash_detector.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/geometry.hpp"
@@ -219,13 +220,11 @@ int run(const Settings& s) {
   sim::Plant<D::Model> plant(model);
   const sim::Pose2 start = track.start_pose();
   auto respawn_at = [&](double x, double y) {
-    const sim::ClosestPoint c = sim::closest_point(track.centreline(), true, {x, y});
-    const sim::Vec2 a = track.centreline()[c.segment];
-    const sim::Vec2 b = track.centreline()[(c.segment + 1) % track.centreline().size()];
+    const sim::Pose2 p = sim::centreline_pose_nearest(track, {x, y});
     VehicleState v;
-    v.x_m = static_cast<float>(c.point.x);
-    v.y_m = static_cast<float>(c.point.y);
-    v.yaw_rad = static_cast<float>(std::atan2(b.y - a.y, b.x - a.x));
+    v.x_m = static_cast<float>(p.x_m);
+    v.y_m = static_cast<float>(p.y_m);
+    v.yaw_rad = static_cast<float>(p.yaw_rad);
     plant.reset(v);
   };
   respawn_at(start.x_m, start.y_m);

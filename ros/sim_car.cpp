@@ -7,6 +7,7 @@
 #include "chassis/sim_adapter.hpp"
 #include "dynamics/single_track.hpp"
 #include "dynamics/vehicle_params.hpp"
+#include "sim/centreline_pose.hpp"
 #include "sim/crash_detector.hpp"
 #include "sim/data_dir.hpp"
 #include "sim/geometry.hpp"
@@ -64,13 +65,11 @@ struct SimCar::Impl {
 
   void put_back() {
     const VehicleState s = plant.vehicle_state();
-    const sim::ClosestPoint c = sim::closest_point(track.centreline(), true, {s.x_m, s.y_m});
-    const sim::Vec2 a = track.centreline()[c.segment];
-    const sim::Vec2 b = track.centreline()[(c.segment + 1) % track.centreline().size()];
+    const sim::Pose2 p = sim::centreline_pose_nearest(track, {s.x_m, s.y_m});
     VehicleState respawn;
-    respawn.x_m = static_cast<float>(c.point.x);
-    respawn.y_m = static_cast<float>(c.point.y);
-    respawn.yaw_rad = static_cast<float>(std::atan2(b.y - a.y, b.x - a.x));
+    respawn.x_m = static_cast<float>(p.x_m);
+    respawn.y_m = static_cast<float>(p.y_m);
+    respawn.yaw_rad = static_cast<float>(p.yaw_rad);
     plant.reset(respawn);
   }
 

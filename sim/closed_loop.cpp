@@ -31,6 +31,7 @@
 #include "sim/data_dir.hpp"
 #include "sim/geometry.hpp"
 #include "sim/lap_counter.hpp"
+#include "sim/centreline_pose.hpp"
 #include "sim/limit_lap.hpp"
 #include "sim/limit_lap_methods.hpp"
 #include "sim/path_predictor.hpp"
@@ -282,13 +283,11 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   bool motion_enabled = true;
   // A marshal puts the car back on the centreline nearest to it, at rest, facing along the track.
   auto marshal_puts_back = [&](const VehicleState& s) {
-    const ClosestPoint c = closest_point(track.centreline(), true, {s.x_m, s.y_m});
-    const Vec2 a = track.centreline()[c.segment];
-    const Vec2 b = track.centreline()[(c.segment + 1) % track.centreline().size()];
+    const Pose2 p = centreline_pose_nearest(track, {s.x_m, s.y_m});
     VehicleState respawn;
-    respawn.x_m = static_cast<float>(c.point.x);
-    respawn.y_m = static_cast<float>(c.point.y);
-    respawn.yaw_rad = static_cast<float>(std::atan2(b.y - a.y, b.x - a.x));
+    respawn.x_m = static_cast<float>(p.x_m);
+    respawn.y_m = static_cast<float>(p.y_m);
+    respawn.yaw_rad = static_cast<float>(p.yaw_rad);
     plant.reset(respawn);
     controller->reset();
   };
@@ -480,12 +479,7 @@ std::optional<SingleTrackParams> plant_vehicle_params(const ClosedLoopConfig& co
 
 RunSummary run_closed_loop(const ClosedLoopConfig& given) {
   ClosedLoopConfig config = given;
-  if (const auto names = limit_lap_method_names();
-      std::find(names.begin(), names.end(), config.limit_lap_method) == names.end()) {
-    std::string known;
-    for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
-    throw Error("limit_lap_method: unknown method '" + config.limit_lap_method + "' (known here: " + known + ")");
-  }
+  require_limit_lap_method(config.limit_lap_method);
   if (!config.actuator_model.empty() && config.actuator_model != "none")
     config.controller.actuators =
         resolve_actuator_model(config.actuator_model, config.plant, config.plant_params_yaml, config.actuators);

@@ -1,5 +1,6 @@
 #include "sim/limit_lap_methods.hpp"
 
+#include <algorithm>
 #include <map>
 #include <mutex>
 
@@ -36,6 +37,15 @@ std::vector<std::string> limit_lap_method_names() {
   return names;
 }
 
+void require_limit_lap_method(const std::string& name) {
+  const std::vector<std::string> names = limit_lap_method_names();
+  if (std::find(names.begin(), names.end(), name) != names.end()) return;
+  std::string known;
+  for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
+  throw Error("unknown limit-lap method '" + name + "' (known here: " + known +
+              "; 'collocation' needs the build with IPOPT, coinor-libipopt-dev)");
+}
+
 LimitLap limit_lap_by_method(const std::string& name, const Track& track, const SingleTrackParams& vehicle) {
   LimitLapMethod method;
   {
@@ -44,12 +54,7 @@ LimitLap limit_lap_by_method(const std::string& name, const Track& track, const 
     auto it = r.methods.find(name);
     if (it != r.methods.end()) method = it->second;
   }
-  if (!method) {
-    std::string known;
-    for (const std::string& n : limit_lap_method_names()) known += (known.empty() ? "" : ", ") + n;
-    throw Error("unknown limit-lap method '" + name + "' (known here: " + known +
-                "; 'collocation' needs the build with IPOPT, coinor-libipopt-dev)");
-  }
+  if (!method) require_limit_lap_method(name);  // throws, naming the known methods
   return method(track, vehicle);
 }
 

@@ -22,6 +22,9 @@ void register_limit_lap_method(const std::string& name, LimitLapMethod method);
 // ones) and whatever the method throws.
 LimitLap limit_lap_by_method(const std::string& name, const Track& track, const SingleTrackParams& vehicle);
 
+// Throws mppi::Error for a name that is not registered, listing the known ones.
+void require_limit_lap_method(const std::string& name);
+
 // The registered names, "qss" first.
 std::vector<std::string> limit_lap_method_names();
 

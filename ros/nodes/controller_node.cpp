@@ -34,6 +34,7 @@
 #include "ros/controller_setup.hpp"
 #include "ros/latency_stats.hpp"
 #include "ros/odometry_state.hpp"
+#include "ros/nodes/node_params.hpp"
 #include "ros/nodes/ros_messages.hpp"
 #include "ros/safety_monitor.hpp"
 
@@ -56,12 +57,7 @@ double now_s() { return ros::Time::now().toSec(); }
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }  // the loop ends within a control period
 
-// A private parameter, if set; one of another type is refused by name (not silently ignored).
-template <class T>
-void read_param(ros::NodeHandle& nh, const std::string& name, T& value) {
-  if (nh.hasParam(name) && !nh.getParam(name, value))
-    throw mppi::Error("parameter " + nh.resolveName(name) + " has the wrong type");
-}
+using mppi::ros::read_param;
 
 }  // namespace
 

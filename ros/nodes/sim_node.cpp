@@ -28,6 +28,7 @@
 #include <ros/ros.h>
 
 #include "ros/chassis_convention.hpp"
+#include "ros/nodes/node_params.hpp"
 #include "ros/nodes/ros_messages.hpp"
 #include "ros/sim_car.hpp"
 
@@ -36,12 +37,7 @@ namespace {
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
 
-// A private parameter, if set; one of another type is refused by name (not silently ignored).
-template <class T>
-void read_param(ros::NodeHandle& nh, const std::string& name, T& value) {
-  if (nh.hasParam(name) && !nh.getParam(name, value))
-    throw std::runtime_error("parameter " + nh.resolveName(name) + " has the wrong type");
-}
+using mppi::ros::read_param;
 
 }  // namespace
 
