@@ -159,6 +159,24 @@ PYBIND11_MODULE(mppi, m) {
       .def_readwrite("lambda_min", &mppi::TemperatureTarget::lambda_min)
       .def_readwrite("lambda_max", &mppi::TemperatureTarget::lambda_max)
       .def_readwrite("tolerance", &mppi::TemperatureTarget::tolerance);
+  py::class_<mppi::LateralForceAdaptation>(m, "LateralForceAdaptation",
+                                           "online adaptation of the model's lateral tyre force to the measured motion")
+      .def(py::init<>())
+      .def_readwrite("enabled", &mppi::LateralForceAdaptation::enabled)
+      .def_readwrite("memory_s", &mppi::LateralForceAdaptation::memory_s, "time over which evidence is forgotten [s]")
+      .def_readwrite("prior_weight", &mppi::LateralForceAdaptation::prior_weight)
+      .def_readwrite("min_scale", &mppi::LateralForceAdaptation::min_scale)
+      .def_readwrite("max_scale", &mppi::LateralForceAdaptation::max_scale)
+      .def_readwrite("min_speed_mps", &mppi::LateralForceAdaptation::min_speed_mps)
+      .def_readwrite("max_accel_mps2", &mppi::LateralForceAdaptation::max_accel_mps2)
+      .def_readwrite("speed_param", &mppi::LateralForceAdaptation::speed_param,
+                     "cost parameter held at the requested value x sqrt(scale); empty = off")
+      .def_readwrite("speed_exponent", &mppi::LateralForceAdaptation::speed_exponent,
+                     "the speed parameter is held at the requested value x scale^speed_exponent")
+      .def_readwrite("throttle_exponent", &mppi::LateralForceAdaptation::throttle_exponent,
+                     "the throttle's upper limit is held at the configured one x scale^throttle_exponent (0: kept)")
+      .def_readwrite("scale_model", &mppi::LateralForceAdaptation::scale_model,
+                     "plan with the model's lateral force x scale as well");
   py::class_<mppi::ActuatorChannel>(m, "ActuatorChannel",
                                     "one channel's actuator: pure delay, rate limit, first-order lag")
       .def(py::init<>())
@@ -189,6 +207,7 @@ PYBIND11_MODULE(mppi, m) {
       .def_readwrite("num_threads", &mppi::ControllerOptions::num_threads)
       .def_readwrite("sampler", &mppi::ControllerOptions::sampler)
       .def_readwrite("temperature", &mppi::ControllerOptions::temperature)
+      .def_readwrite("force_adaptation", &mppi::ControllerOptions::force_adaptation)
       .def_property("variant",
                     [](const mppi::ControllerOptions& o) { return std::string(mppi::variant_name(o.variant)); },
                     [](mppi::ControllerOptions& o, const std::string& name) {
@@ -226,6 +245,7 @@ PYBIND11_MODULE(mppi, m) {
       .def_readonly("mean_cost", &mppi::StepSummary::mean_cost)
       .def_readonly("effective_sample_size", &mppi::StepSummary::effective_sample_size)
       .def_readonly("valid_samples", &mppi::StepSummary::valid_samples)
+      .def_readonly("lateral_force_scale", &mppi::StepSummary::lateral_force_scale)
       .def_readonly("iterations", &mppi::StepSummary::iterations)
       .def_readonly("lambda_", &mppi::StepSummary::lambda, "temperature of the weights")
       .def_readonly("tube_distance", &mppi::StepSummary::tube_distance)
@@ -488,6 +508,9 @@ PYBIND11_MODULE(mppi, m) {
       .def_readonly("ess_target_share", &Sum::ess_target_share)
       .def_readonly("ess_in_band_share", &Sum::ess_in_band_share)
       .def_readonly("lambda_p50", &Sum::lambda_p50)
+      .def_readonly("lateral_force_adaptation", &Sum::lateral_force_adaptation)
+      .def_readonly("lateral_force_scale_final", &Sum::lateral_force_scale_final)
+      .def_readonly("lateral_force_scale_p50", &Sum::lateral_force_scale_p50)
       .def_readonly("actuator_model", &Sum::actuator_model)
       .def_readonly("variant", &Sum::variant)
       .def_readonly("nominal_resets", &Sum::nominal_resets)

@@ -164,6 +164,26 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
                         "tube / robust: the feedback's control weights, comma-separated, one per control "
                         "(empty: 1 each)")
       ->type_name("R,...");
+  app.add_flag("--adapt-grip", mppi.force_adaptation.enabled,
+               "online grip adaptation: fit a scale of the model's lateral tyre force to the measured motion at "
+               "every step and hold the target speed at --speed x scale^--adapt-speed-exponent (CPU backend; "
+               "mppi/lateral_force_adaptation.hpp)");
+  app.add_flag("--adapt-model", mppi.force_adaptation.scale_model,
+               "online grip adaptation: plan with the model's lateral force x the scale as well (the AutoRally "
+               "network)");
+  add_float_option(app, "--adapt-speed-exponent", mppi.force_adaptation.speed_exponent,
+                   "online grip adaptation: the target speed is --speed x scale^this (0.5: steady cornering's "
+                   "sqrt(mu); 1: with a margin)")
+      ->type_name("E")
+      ->check(CLI::Range(0.0, 2.0));
+  add_float_option(app, "--adapt-throttle-exponent", mppi.force_adaptation.throttle_exponent,
+                   "online grip adaptation: the throttle's upper limit is the configured one x scale^this (0: kept)")
+      ->type_name("E")
+      ->check(CLI::Range(0.0, 2.0));
+  add_float_option(app, "--adapt-memory", mppi.force_adaptation.memory_s,
+                   "online adaptation: time over which the evidence is forgotten [s]")
+      ->type_name("S")
+      ->check(CLI::PositiveNumber);
   app.add_option("--actuator-model", c.actuator_model,
                  "the actuators the controller plans through (delay, rate limit, lag per channel): none | plant "
                  "(the simulated car's own) | a corrected-model FILE (mppi-fit diagnose)")

@@ -6,6 +6,7 @@
 // value at/above the boundary threshold, roll too large, or yaw rate too large), else 0.
 // Stateless per step: unlike upstream costs.cu the crash flag does not latch over a rollout.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -68,9 +69,10 @@ struct AutoRallyCostParams {
 };
 
 // The cost's parameter table (YAML key, unit, range, doc): the YAML loader (costs/cost_config.cpp),
-// set_param() and help text come from it. Its ranges are those is_valid() checks.
-inline std::vector<ParamField> param_table(AutoRallyCostParams& p) {
-  return {
+// set_param() and help text come from it. Its ranges are those is_valid() checks. An array, so
+// that set_param() allocates nothing (a speed governor changes the target speed inside step()).
+inline std::array<ParamField, 10> cost_param_array(AutoRallyCostParams& p) {
+  return {{
       param("track_weight", &p.track_weight, "1/cost-map unit", non_negative(), "w1: weight of the cost-map value C_M"),
       param("speed_weight", &p.speed_weight, "s^2/m^2", non_negative(), "w2: weight of (v_x - v_x^d)^2"),
       param("crash_weight", &p.crash_weight, "-", non_negative(), "w3: cost of a crash at t = 0"),
@@ -82,7 +84,11 @@ inline std::vector<ParamField> param_table(AutoRallyCostParams& p) {
       param("max_roll_rad", &p.max_roll_rad, "rad", positive_or_inf(), "|roll| above which the car rolled over"),
       param("max_yaw_rate_radps", &p.max_yaw_rate_radps, "rad/s", positive_or_inf(), "|yaw rate| above which the car spins"),
       param("slip_min_speed_mps", &p.slip_min_speed_mps, "m/s", positive(), "v_x floor of the slip term"),
-  };
+  }};
+}
+inline std::vector<ParamField> param_table(AutoRallyCostParams& p) {
+  const auto fields = cost_param_array(p);
+  return {fields.begin(), fields.end()};
 }
 
 class AutoRallyCost {
@@ -101,7 +107,7 @@ class AutoRallyCost {
   // False, with the reason in *why, for an unknown key or a value out of range; nothing changes.
   bool set_param(std::string_view key, double value, std::string* why) {
     AutoRallyCostParams p = params_;
-    for (const ParamField& f : param_table(p)) {
+    for (const ParamField& f : cost_param_array(p)) {
       if (key != f.key) continue;
       f.set(value);
       if (!in_range(f) || !p.is_valid(why)) {

@@ -22,10 +22,12 @@
 #include <algorithm>
 #include <cstddef>
 #include <string>
+#include <string_view>
 
 #include "base/batch.hpp"
 #include "dynamics/fast_trig.hpp"
 #include "dynamics/mlp.hpp"
+#include "mppi/lateral_force_adaptation.hpp"
 #include "mppi/vehicle_state.hpp"
 
 namespace mppi {
@@ -56,6 +58,20 @@ class AutoRallyNetwork {
   bool set_precision(NetPrecision precision) { return net_.set_precision(precision); }
   NetPrecision precision() const { return net_.precision(); }
 
+  // The share of the network's lateral tyre force the car has (online adaptation of the model,
+  // mppi/lateral_force_adaptation.hpp). The network's d vy/dt is the tyres' lateral force per
+  // mass minus the kinematic term vx r, and its d r/dt the tyres' yaw moment per inertia; the
+  // scale s multiplies both force terms and keeps the kinematic one:
+  //   d vy/dt = net_vy + (s - 1) (net_vy + vx r),   d r/dt = net_r + (s - 1) net_r.
+  // A friction change that scales the whole tyre curve (Pacejka D) scales both by the same s.
+  // s = 1 (the default) leaves every number as the network gives it, bit for bit.
+  static constexpr std::string_view kLateralForceScaleKey = kLateralForceScaleParam;
+  static constexpr double kMinLateralForceScale = 0.2, kMaxLateralForceScale = 2.0;
+  // Sets kLateralForceScaleKey (in [kMinLateralForceScale, kMaxLateralForceScale]). False with
+  // the reason in *why for another key or a value out of range; nothing changes then.
+  bool set_param(std::string_view key, double value, std::string* why);
+  float lateral_force_scale() const { return lateral_force_scale_; }
+
   std::size_t scratch_floats(int width) const {
     return static_cast<std::size_t>(kNetIn + kNetOut) * static_cast<std::size_t>(width) +
            net_.scratch_floats(width);
@@ -85,18 +101,19 @@ class AutoRallyNetwork {
     const float* d_vx = der + 1 * W;
     const float* d_vy = der + 2 * W;
     const float* d_r = der + 3 * W;
+    const float extra_force = lateral_force_scale_ - 1.f;  // 0: the network's own numbers
     MPPI_SIMD_LOOP
     for (int j = 0; j < W; ++j) {
       float s, c;
       fast_sincos(pyaw[j], &s, &c);
-      const float vx = pvx[j], vy = pvy[j];
+      const float vx = pvx[j], vy = pvy[j], r = pr[j];
       px[j] += (c * vx - s * vy) * dt_s;
       py[j] += (s * vx + c * vy) * dt_s;
-      pyaw[j] += pr[j] * dt_s;
+      pyaw[j] += r * dt_s;
       proll[j] += d_roll[j] * dt_s;
       pvx[j] = vx + d_vx[j] * dt_s;
-      pvy[j] = vy + d_vy[j] * dt_s;
-      pr[j] += d_r[j] * dt_s;
+      pvy[j] = vy + (d_vy[j] + extra_force * (d_vy[j] + vx * r)) * dt_s;
+      pr[j] = r + (d_r[j] + extra_force * d_r[j]) * dt_s;
     }
   }
 
@@ -117,6 +134,7 @@ class AutoRallyNetwork {
 
  private:
   Mlp net_;  // library conventions
+  float lateral_force_scale_ = 1.f;
 };
 
 }  // namespace mppi

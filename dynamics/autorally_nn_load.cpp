@@ -56,8 +56,25 @@ void AutoRallyNetwork::derivatives(const double* x, const double* u, double* dx)
   dx[state::kYaw] = x[state::kYawRate];
   dx[state::kRoll] = out[0];
   dx[state::kVx] = out[1];
-  dx[state::kVy] = out[2];
-  dx[state::kYawRate] = out[3];
+  const double extra_force = static_cast<double>(lateral_force_scale_) - 1.0;
+  dx[state::kVy] = out[2] + extra_force * (out[2] + vx * x[state::kYawRate]);
+  dx[state::kYawRate] = out[3] + extra_force * out[3];
+}
+
+bool AutoRallyNetwork::set_param(std::string_view key, double value, std::string* why) {
+  if (key != kLateralForceScaleKey) {
+    if (why) *why = "the AutoRally network has no parameter \"" + std::string(key) + "\" (it has \"" +
+                    std::string(kLateralForceScaleKey) + "\")";
+    return false;
+  }
+  if (!(value >= kMinLateralForceScale && value <= kMaxLateralForceScale)) {
+    if (why)
+      *why = std::string(kLateralForceScaleKey) + " must be in [" + std::to_string(kMinLateralForceScale) + ", " +
+             std::to_string(kMaxLateralForceScale) + "], got " + std::to_string(value);
+    return false;
+  }
+  lateral_force_scale_ = static_cast<float>(value);
+  return true;
 }
 
 void AutoRallyNetwork::derivatives_autorally_frame(const double s[7], const double u[2], double out[4]) const {

@@ -104,6 +104,22 @@ class Backend {
     return false;
   }
 
+  // A parameter of the model changed while the controller runs (online adaptation, e.g. the
+  // AutoRally network's "lateral_force_scale"). False with the reason in *why if the model has
+  // no such parameter, the value is out of range or this backend cannot change its model.
+  virtual bool set_model_param(std::string_view /*key*/, double /*value*/, std::string* why) {
+    if (why) *why = std::string(name()) + " backend: its model cannot change while it runs";
+    return false;
+  }
+  // One model step of dt from x0 (num_states) under the model input u (num_controls, after the
+  // actuators) into x1 (num_states), with the model as it is now. False with the reason in *why
+  // if a size is wrong or this backend cannot step its model on its own.
+  virtual bool predict_step(std::span<const float> /*x0*/, std::span<const float> /*u*/,
+                            std::span<float> /*x1*/, std::string* why) {
+    if (why) *why = std::string(name()) + " backend cannot step its model on its own";
+    return false;
+  }
+
   // The ancillary feedback of Tube-MPPI / Robust MPPI along a plan: rolls `nominal` (T x nu)
   // out from x0 (num_states) into states_out ((T+1) x nx: x0 .. x_T) and writes the
   // time-varying LQR gains of the model linearised along it into gains_out (T x nu x nx,

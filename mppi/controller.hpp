@@ -29,6 +29,7 @@
 #include "mppi/controller_options.hpp"
 #include "mppi/cpu_backend.hpp"
 #include "mppi/fault_injection.hpp"
+#include "mppi/lateral_force_adaptation.hpp"
 #include "mppi/noise.hpp"
 #include "mppi/savitzky_golay.hpp"
 #include "mppi/thread_schedule.hpp"
@@ -58,6 +59,9 @@ struct StepSummary {
   float tube_distance = 0.f;
   bool nominal_reset = false;
   bool feedback_applied = false;     // the ancillary gains were computed and applied
+  // Online adaptation (ControllerOptions::force_adaptation): the estimated scale of the model's
+  // lateral force this step planned with (1 when the adaptation is off).
+  float lateral_force_scale = 1.f;
   double optimizer_ms = 0.0;         // wall time of step()
 };
 
@@ -162,6 +166,24 @@ class Controller {
                     backend_->name() + " backend does not");
       for (const ActuatorChannel& c : options_.actuators) actuator_steps_.push_back(actuator_step(c, options_.dt_s));
     }
+    acting_input_.assign(nu_, 0.f);
+    if (options_.force_adaptation.enabled) {
+      if (nx_ < state::kCommonStates)
+        throw Error("ControllerOptions: lateral force adaptation needs a vehicle model (its first " +
+                    std::to_string(state::kCommonStates) + " states the common ones), the model has " +
+                    std::to_string(nx_) + " states");
+      if (options_.force_adaptation.scale_model)
+        for (Backend* b : {backend_.get(), feedback_backend_.get()})
+          if (b && !b->set_model_param(kLateralForceScaleParam, 1.0, &why))
+            throw Error("ControllerOptions: lateral force adaptation with scale_model needs a model parameter \"" +
+                        std::string(kLateralForceScaleParam) + "\" that the backend can set: " + why);
+      force_estimator_ = LateralForceScaleEstimator(options_.force_adaptation);
+      if (nu_ > control::kThrottle) throttle_max_configured_ = options_.control_max[control::kThrottle];
+      adapt_previous_.assign(nx_, 0.f);
+      adapt_predicted_.assign(nx_, 0.f);
+      if (!backend_->predict_step(adapt_previous_, acting_input_, adapt_predicted_, &why))
+        throw Error("ControllerOptions: lateral force adaptation: " + why);
+    }
     reset();
   }
 
@@ -174,16 +196,19 @@ class Controller {
     StepSummary local;
     StepSummary& sum = summary ? *summary : local;
     sum = StepSummary{};
+    sum.lateral_force_scale = force_scale_;
     ++step_calls_;
     bool finite = x0.size() == static_cast<std::size_t>(nx_);
     for (std::size_t i = 0; finite && i < x0.size(); ++i) finite = std::isfinite(x0[i]);
     if (!finite) {
+      adapt_have_previous_ = false;
       sum.status = StepStatus::kInvalidState;
       sum.reason = x0.size() != static_cast<std::size_t>(nx_) ? "state has the wrong size"
                                                                : "state contains NaN or inf";
       return safe_output(sum, start);
     }
     std::copy(x0.begin(), x0.end(), x0_.begin());
+    adapt_model(sum);
     if (feedback()) choose_nominal_state(sum);
     try {
       // A cold plan (first step after construction or reset) gets the warm-start iterations
@@ -232,16 +257,30 @@ class Controller {
   // *why, if the key is unknown, the value out of range or the backend cannot change its cost;
   // the cost is then unchanged.
   // The changes are kept and applied again to a fallback backend when the controller switches.
+  // With the lateral force adaptation on, its speed parameter (options().force_adaptation
+  // .speed_param) is the requested speed: the cost gets it x scale^speed_exponent.
   bool set_cost_param(std::string_view key, double value, std::string* why = nullptr) {
+    if (governs(key)) {
+      const double requested = value;
+      value *= speed_factor();
+      if (!guarded(why, [&] { return backend_->set_cost_param(key, value, why); })) return false;
+      requested_speed_ = requested;
+      governed_speed_ = value;
+      if (feedback_backend_ && !guarded(why, [&] { return feedback_backend_->set_cost_param(key, value, why); }))
+        return false;
+      remember_cost_param(key, value);
+      return true;
+    }
     if (!guarded(why, [&] { return backend_->set_cost_param(key, value, why); })) return false;
     if (feedback_backend_ && !guarded(why, [&] { return feedback_backend_->set_cost_param(key, value, why); }))
       return false;
-    auto same_key = [&](const auto& kv) { return kv.first == key; };
-    const auto it = std::find_if(cost_params_.begin(), cost_params_.end(), same_key);
-    if (it != cost_params_.end()) it->second = value;
-    else cost_params_.emplace_back(std::string(key), value);
+    remember_cost_param(key, value);
     return true;
   }
+  // The speed the host asked for through set_cost_param (NaN if none) and the one the cost has,
+  // with the lateral force adaptation on.
+  double requested_speed() const { return requested_speed_; }
+  double governed_speed() const { return governed_speed_; }
   bool set_cost_map(std::shared_ptr<const CostMap> map, std::string* why = nullptr) {
     if (!guarded(why, [&] { return backend_->set_cost_map(map, why); })) return false;
     if (feedback_backend_ && !guarded(why, [&] { return feedback_backend_->set_cost_map(map, why); })) return false;
@@ -268,12 +307,19 @@ class Controller {
 
   // Forget the plan (nominal = zero controls clamped to the limits) and the actuators' state
   // (at rest: every input 0, nothing pending).
+  // The adapted lateral force scale is kept: the car and the surface are the same after a
+  // respawn.
   void reset() {
     reset_plan();
     step_index_ = 0;
     actuator_state_ = ActuatorState{};
     have_nominal_state_ = false;
+    adapt_have_previous_ = false;
   }
+
+  // The estimated scale of the model's lateral force now (ControllerOptions::force_adaptation;
+  // 1 when off); the model itself has it only with force_adaptation.scale_model.
+  float lateral_force_scale() const { return force_scale_; }
 
   // Tube / robust variants: the plan's states from the nominal state ((T + 1) x nx) and the
   // feedback gains along it (T x nu x nx, u_t = u_nom_t + K_t (x_t - x_nom_t)) of the last
@@ -531,9 +577,74 @@ class Controller {
     }
   }
 
-  // The command goes out: the actuator chain moves on by one step.
+  // The command goes out: the actuator chain moves on by one step; the model's input until the
+  // next step is the chain's output (or the command itself without a chain).
   void sent(std::span<const float> command) {
-    if (!actuator_steps_.empty()) advance_actuators(actuator_steps_.data(), nu_, command.data(), actuator_state_);
+    if (!actuator_steps_.empty()) {
+      advance_actuators(actuator_steps_.data(), nu_, command.data(), actuator_state_);
+      std::copy_n(actuator_state_.lag_out, nu_, acting_input_.begin());
+    } else {
+      std::copy(command.begin(), command.end(), acting_input_.begin());
+    }
+  }
+
+  // Online adaptation of the model's lateral force (mppi/lateral_force_adaptation.hpp): the
+  // model's step from the last measured state under the input that acted, against the state
+  // measured now (x0_). A backend that fails here fails again in the iteration that follows,
+  // which handles it; the scale then stays.
+  void adapt_model(StepSummary& sum) noexcept {
+    if (!options_.force_adaptation.enabled) return;
+    if (adapt_have_previous_) {
+      try {
+        if (backend_->predict_step(adapt_previous_, acting_input_, adapt_predicted_, nullptr)) {
+          const float scale = force_estimator_.update(adapt_previous_.data(), adapt_predicted_.data(), x0_.data(),
+                                                      options_.dt_s, model_scale_);
+          if (scale != force_scale_) {
+            force_scale_ = scale;
+            if (options_.force_adaptation.scale_model && backend_->set_model_param(kLateralForceScaleParam, scale, nullptr)) {
+              if (feedback_backend_) feedback_backend_->set_model_param(kLateralForceScaleParam, scale, nullptr);
+              model_scale_ = scale;
+            }
+            govern_speed();
+            govern_throttle();
+          }
+        }
+      } catch (...) {
+      }
+    }
+    std::copy(x0_.begin(), x0_.end(), adapt_previous_.begin());
+    adapt_have_previous_ = true;
+    sum.lateral_force_scale = force_scale_;
+  }
+
+  // The target speed the cost gets: the requested one x scale^speed_exponent, sent again when it moved by
+  // more than 0.5 % (the cost's parameter is a float; no allocation).
+  void govern_speed() {
+    if (!std::isfinite(requested_speed_)) return;
+    const double speed = requested_speed_ * speed_factor();
+    if (std::abs(speed - governed_speed_) <= 0.005 * std::abs(requested_speed_)) return;
+    const std::string_view key = options_.force_adaptation.speed_param;
+    if (!backend_->set_cost_param(key, speed, nullptr)) return;
+    if (feedback_backend_) feedback_backend_->set_cost_param(key, speed, nullptr);
+    governed_speed_ = speed;
+    for (auto& [k, v] : cost_params_)
+      if (k == key) v = speed;
+  }
+  // The throttle's upper limit: the configured one x scale^throttle_exponent, above the lower
+  // limit and the safe control's throttle.
+  void govern_throttle() noexcept {
+    if (!(options_.force_adaptation.throttle_exponent > 0.f) || nu_ <= control::kThrottle) return;
+    const int c = control::kThrottle;
+    const float factor = std::pow(force_scale_, options_.force_adaptation.throttle_exponent);
+    const float floor = std::max(options_.control_min[c], options_.safe_control[c]) + 1e-3f;
+    options_.control_max[c] = std::max(throttle_max_configured_ * factor, floor);
+  }
+  double speed_factor() const {
+    return std::pow(static_cast<double>(force_scale_), static_cast<double>(options_.force_adaptation.speed_exponent));
+  }
+  bool governs(std::string_view key) const {
+    return options_.force_adaptation.enabled && !options_.force_adaptation.speed_param.empty() &&
+           key == options_.force_adaptation.speed_param;
   }
 
   void shift_nominal() {
@@ -546,6 +657,13 @@ class Controller {
     for (int t = 0; t < options_.horizon; ++t)
       for (int c = 0; c < nu_; ++c)
         nominal_[t * nu_ + c] = std::clamp(0.f, options_.control_min[c], options_.control_max[c]);
+  }
+
+  void remember_cost_param(std::string_view key, double value) {
+    auto same_key = [&](const auto& kv) { return kv.first == key; };
+    const auto it = std::find_if(cost_params_.begin(), cost_params_.end(), same_key);
+    if (it != cost_params_.end()) it->second = value;
+    else cost_params_.emplace_back(std::string(key), value);
   }
 
   // Runs a backend call that may throw; an exception becomes false with its message in *why.
@@ -582,6 +700,9 @@ class Controller {
               failure_reason_ += "; the fallback refused cost parameter " + key + ": " + why;
           if (cost_map_ && !fallback->set_cost_map(cost_map_, &why))
             failure_reason_ += "; the fallback refused the cost map: " + why;
+          if (options_.force_adaptation.scale_model &&
+              !fallback->set_model_param(kLateralForceScaleParam, model_scale_, &why))
+            failure_reason_ += "; the fallback refused the lateral force scale: " + why;
           switches_.push_back({step_calls_ - 1, backend_->name(), fallback->name(), failure_reason_});
           backend_ = std::move(fallback);
           if (!backend_->has_iterate() && controls_.empty())
@@ -642,6 +763,17 @@ class Controller {
   std::vector<float> measured_;        // nx: this step's measured state
   std::vector<float> nominal_states_;  // (T + 1) x nx along the last plan
   std::vector<float> gains_;           // T x nu x nx
+  // the model's input until the next step (nu): the command sent, after the actuators
+  std::vector<float> acting_input_;
+  // online adaptation (options_.force_adaptation)
+  LateralForceScaleEstimator force_estimator_;
+  float force_scale_ = 1.f;  // the estimate
+  float model_scale_ = 1.f;  // the model's (the estimate with scale_model, else 1)
+  float throttle_max_configured_ = 0.f;  // options_.control_max[kThrottle] as configured
+  std::vector<float> adapt_previous_, adapt_predicted_;  // nx: the last measured state, its prediction
+  bool adapt_have_previous_ = false;
+  double requested_speed_ = std::numeric_limits<double>::quiet_NaN();  // governs(): the host's speed
+  double governed_speed_ = std::numeric_limits<double>::quiet_NaN();   // governs(): the cost's speed
 };
 
 // A controller on the CPU backend for model D and cost C.

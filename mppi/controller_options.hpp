@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "mppi/actuator_chain.hpp"
+#include "mppi/lateral_force_adaptation.hpp"
 #include "mppi/adaptive_temperature.hpp"
 #include "mppi/ancillary.hpp"
 #include "mppi/sampler.hpp"
@@ -80,6 +81,11 @@ struct ControllerOptions {
   // each channel's command and the model's input; empty = the model takes the command directly.
   std::vector<ActuatorChannel> actuators;
 
+  // Online adaptation of the model's lateral tyre force to the measured motion
+  // (mppi/lateral_force_adaptation.hpp); the model must have the parameter
+  // "lateral_force_scale" (the AutoRally network) and the backend must change it (CPU).
+  LateralForceAdaptation force_adaptation;
+
   // Checks against a model with `num_controls` channels; on failure writes why.
   bool is_valid(int num_controls, std::string* why) const {
     auto fail = [&](const std::string& msg) {
@@ -126,6 +132,7 @@ struct ControllerOptions {
         return fail("temperature.tolerance must be in (0, 1)");
     }
     if (!actuators_are_valid(actuators, num_controls, dt_s, why)) return false;
+    if (!force_adaptation.is_valid(why)) return false;
     if (variant != ControllerVariant::kPlain) {
       if (!actuators.empty())
         return fail("the tube and robust variants plan without an actuator chain (actuators must be empty)");

@@ -340,6 +340,28 @@ class CpuBackend final : public Backend {
     if constexpr (requires { cost_.set_map(map, why); }) return cost_.set_map(std::move(map), why);
     else return Backend::set_cost_map(std::move(map), why);
   }
+  bool set_model_param(std::string_view key, double value, std::string* why) override {
+    if constexpr (requires { model_.set_param(key, value, why); }) return model_.set_param(key, value, why);
+    else return Backend::set_model_param(key, value, why);
+  }
+  // One step of the model in a chunk whose lanes all hold x0 and u (lane 0 is taken). Uses the
+  // first thread's work slice (iterate() is not running).
+  bool predict_step(std::span<const float> x0, std::span<const float> u, std::span<float> x1,
+                    std::string* why) override {
+    if (x0.size() != static_cast<std::size_t>(D::kNx) || u.size() != static_cast<std::size_t>(D::kNu) ||
+        x1.size() != static_cast<std::size_t>(D::kNx)) {
+      if (why) *why = "cpu backend: predict_step needs x0 and x1 of num_states and u of num_controls";
+      return false;
+    }
+    constexpr int W = kChunk;
+    float* x = work_.data();
+    float* in = x + D::kNx * W;
+    for (int i = 0; i < D::kNx; ++i) std::fill_n(x + i * W, W, x0[i]);
+    for (int c = 0; c < D::kNu; ++c) std::fill_n(in + c * W, W, u[c]);
+    model_.template step<W>(Batch<D::kNx, W>{x}, ConstBatch<D::kNu, W>{in}, dt_s_, in + D::kNu * W);
+    for (int i = 0; i < D::kNx; ++i) x1[i] = x[i * W];
+    return true;
+  }
 
   // The whole iteration in one parallel pass over the chunks (detail::iterate_chunk), then
   // the chunks combined in order (detail::combine_chunks).

@@ -37,6 +37,15 @@ class DeviceLossInjector final : public Backend {
   bool copy_sampled_controls(std::span<const int> samples, std::span<float> out) const override {
     return inner_->copy_sampled_controls(samples, out);
   }
+  bool set_model_param(std::string_view key, double value, std::string* why) override {
+    if (calls_ > healthy_calls_) throw_lost();
+    return inner_->set_model_param(key, value, why);
+  }
+  bool predict_step(std::span<const float> x0, std::span<const float> u, std::span<float> x1,
+                    std::string* why) override {
+    if (calls_ > healthy_calls_) throw_lost();
+    return inner_->predict_step(x0, u, x1, why);
+  }
   bool set_cost_param(std::string_view key, double value, std::string* why) override {
     if (calls_ > healthy_calls_) throw_lost();
     return inner_->set_cost_param(key, value, why);

@@ -54,6 +54,7 @@ ControllerOptions ControllerNodeSettings::options() const {
   o.num_threads = num_threads;
   o.seed = seed;
   parse_controller_variant(variant, &o.variant);
+  o.force_adaptation.enabled = adapt_grip;
   return o;
 }
 
@@ -93,6 +94,9 @@ NodeController::NodeController(const ControllerNodeSettings& s) : impl_(std::mak
     const typename D::Model model = D::load(file);
     BackendReport report;
     d.controller = std::make_unique<Controller>(make_controller(model, cost, options, choice, &report));
+    // The adaptation governs the target speed the controller was asked for.
+    if (options.force_adaptation.enabled && !d.controller->set_cost_param("target_speed_mps", s.desired_speed, &why))
+      throw Error("controller node parameters: desired_speed: " + why);
     d.backend = report.backend + (report.device.empty() ? "" : " on " + report.device) + " (" + report.reason + ")";
     d.model_states = D::Model::kNx;
     d.observe = [model](const float* common, float* mx) { D::from_plant(model, common, state::kCommonStates, mx); };

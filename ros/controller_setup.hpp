@@ -37,6 +37,9 @@ struct ControllerNodeSettings {
   std::string model_params;         // its data file; empty = the model's default
   std::string backend = "cpu";      // cpu | vulkan | auto
   std::string variant = "plain";    // plain | tube | robust
+  // Online grip adaptation (mppi/lateral_force_adaptation.hpp): the target speed and the
+  // throttle's limit follow the grip fitted from the measured motion (CPU backend).
+  bool adapt_grip = false;
   int num_threads = 0;              // CPU threads; 0 = OpenMP default
   std::uint64_t seed = 1;
   // The operator page (docs/OCS.md) on http://127.0.0.1:serve_port/ (0 = any free port, its URL

@@ -241,7 +241,8 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
         config.out_dir + "/log.csv",
         std::vector<std::string>{"roll", "applied_steer", "applied_throttle", "progress_m",
                                  "lap", "optimizer_ms", "effective_sample_size", "min_cost",
-                                 "slip_angle_rad", "lateral_accel_mps2", "step_status", "backend_switches"},
+                                 "slip_angle_rad", "lateral_accel_mps2", "step_status", "backend_switches",
+                                 "lateral_force_scale"},
         std::vector<std::pair<std::string, std::string>>{
             {"source", "mppi-sim"}, {"track", track.name()}, {"model", config.model},
             {"plant", config.plant}, {"seed", std::to_string(config.controller.seed)},
@@ -263,7 +264,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   long control_step = 0;
 
   std::vector<float> model_x(static_cast<std::size_t>(setup.model_states));
-  std::vector<double> optimizer_ms, ess, lambdas;
+  std::vector<double> optimizer_ms, ess, lambdas, force_scales;
   std::vector<PathSample> path;
   std::vector<PathSample> slip_path;  // the same trail, value = |body slip| [deg]
   std::vector<double> abs_slip;
@@ -280,6 +281,11 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   if (config.through_chassis) chassis.emplace();
   std::size_t next_target = 0;  // next entry of target_speed_schedule
   double target_speed_mps = config.target_speed_mps;
+  // The adaptation holds the cost's target speed at the requested one x sqrt(grip scale): it
+  // learns the request here.
+  if (std::string why; config.controller.force_adaptation.enabled &&
+                       !controller->set_cost_param("target_speed_mps", target_speed_mps, &why))
+    throw Error("the controller refused the target speed: " + why);
   bool motion_enabled = true;
   // A marshal puts the car back on the centreline nearest to it, at rest, facing along the track.
   auto marshal_puts_back = [&](const VehicleState& s) {
@@ -336,6 +342,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
     optimizer_ms.push_back(step_summary.optimizer_ms);
     ess.push_back(step_summary.effective_sample_size);
     lambdas.push_back(step_summary.lambda);
+    force_scales.push_back(step_summary.lateral_force_scale);
     summary.nominal_resets += step_summary.nominal_reset ? 1 : 0;
     for (int i = 0; i < substeps; ++i) {
       plant.advance(command, static_cast<float>(config.plant_dt_s));
@@ -393,7 +400,8 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
                                laps.progress_m(), static_cast<double>(laps.laps_completed()),
                                step_summary.optimizer_ms, step_summary.effective_sample_size,
                                step_summary.min_cost, slip, lat_accel, static_cast<double>(step_summary.status),
-                               static_cast<double>(summary.backend_switches.size())};
+                               static_cast<double>(summary.backend_switches.size()),
+                               step_summary.lateral_force_scale};
       log->write(t, s, command, extras);
     }
     if (config.observer)
@@ -437,6 +445,11 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   summary.actuator_model = config.actuator_model.empty() ? "none" : config.actuator_model;
   if (summary.actuator_model == "none" && !config.controller.actuators.empty()) summary.actuator_model = "custom";
   summary.variant = variant_name(config.controller.variant);
+  summary.lateral_force_adaptation = config.controller.force_adaptation.enabled;
+  if (!force_scales.empty()) {
+    summary.lateral_force_scale_final = force_scales.back();
+    summary.lateral_force_scale_p50 = percentile(force_scales, 50);
+  }
   if (summary.ess_target_share > 0 && !ess.empty()) {
     const double want = summary.ess_target_share * config.controller.num_samples;
     std::size_t in_band = 0;

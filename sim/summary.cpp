@@ -57,6 +57,9 @@ std::string to_json(const RunSummary& s) {
   j["actuator_model"] = s.actuator_model;
   j["variant"] = s.variant;
   j["nominal_resets"] = s.nominal_resets;
+  j["lateral_force_adaptation"] = s.lateral_force_adaptation;
+  j["lateral_force_scale_final"] = number(s.lateral_force_scale_final);
+  j["lateral_force_scale_p50"] = number(s.lateral_force_scale_p50);
   j["backend"] = s.backend;
   j["failed_steps"] = s.failed_steps;
   j["backend_switches"] = nlohmann::ordered_json::array();

@@ -64,6 +64,11 @@ struct RunSummary {
   // was put back on the measured one.
   std::string variant = "plain";
   int nominal_resets = 0;
+  // Online adaptation of the model's lateral force (mppi/lateral_force_adaptation.hpp): on or
+  // off, the scale at the end of the run and its median over the steps (1 when off).
+  bool lateral_force_adaptation = false;
+  double lateral_force_scale_final = 1.0;
+  double lateral_force_scale_p50 = 1.0;
   std::string backend;                // the backend the run started on ("cpu", "vulkan")
   int failed_steps = 0;               // control steps that returned the safe control
   std::vector<BackendSwitchRecord> backend_switches;

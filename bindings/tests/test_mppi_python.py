@@ -257,6 +257,31 @@ def test_controller_variants_from_python():
         mppi.Controller("single-track", cost, o)
 
 
+def test_grip_adaptation_from_python():
+    """The online grip adaptation is settable from Python: the step summary gives the fitted scale,
+    a model without the lateral force parameter is refused by name where the model is to be
+    scaled, and a bad setting is named."""
+    cmap = mppi.CostMap.load_npz(os.path.join(DATA, "autorally/maps/gazebo/gazebo_costmap.npz"))
+    cost = mppi.AutoRallyCost(cmap)
+    o = mppi.ControllerOptions()
+    o.num_samples = 256
+    o.num_threads = 1
+    o.force_adaptation.enabled = True
+    c = mppi.Controller("single-track", cost, o)
+    x = c.model_state(mppi.VehicleState(x_m=-8.5, y_m=-8.9, yaw_rad=2.356, vx_mps=5.0))
+    for _ in range(3):
+        u, s = c.step(x)
+        assert s.status == mppi.StepStatus.OK
+        assert 0.4 <= s.lateral_force_scale <= 1.5
+    o.force_adaptation.scale_model = True
+    with pytest.raises(mppi.Error, match="lateral_force_scale"):
+        mppi.Controller("kinematic", cost, o)
+    mppi.Controller("autorally-nn", cost, o)
+    o.force_adaptation.memory_s = 0.0
+    with pytest.raises(mppi.Error, match="memory_s"):
+        mppi.Controller("single-track", cost, o)
+
+
 def test_tube_variant_publishes_its_gains():
     """The tube variant's gains and nominal states reach Python with their shapes; the control
     sent is the plan's first control plus the first gain times the state error."""

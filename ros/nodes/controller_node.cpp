@@ -86,6 +86,7 @@ int main(int argc, char** argv) {
     read_param(nh, "model_params", s.model_params);
     read_param(nh, "backend", s.backend);
     read_param(nh, "variant", s.variant);
+    read_param(nh, "adapt_grip", s.adapt_grip);
     read_param(nh, "num_threads", s.num_threads);
     read_param(nh, "seed", seed);
     s.seed = static_cast<std::uint64_t>(seed);

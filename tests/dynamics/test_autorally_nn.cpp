@@ -212,3 +212,56 @@ TEST_CASE("autorally_nn: init_state and load errors", "[nn]") {
                                                                  std::vector<float>(3, 0.f)}})),
                     "AutoRallyNetwork: the network must map 6 inputs to 4 outputs, has 6 -> 3");
 }
+
+TEST_CASE("autorally_nn: the lateral force scale multiplies the force terms and keeps the kinematic one", "[nn]") {
+  AutoRallyNetwork model = AutoRallyNetwork::load(model_path());
+  const AutoRallyNetwork reference = model;
+  std::mt19937 rng(5);
+  auto uni = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  std::string why;
+  REQUIRE(model.set_param("lateral_force_scale", 0.6, &why));
+  CHECK(model.lateral_force_scale() == 0.6f);
+  for (int trial = 0; trial < 20; ++trial) {
+    const double x[7] = {uni(-5, 5), uni(-5, 5), uni(-3, 3), uni(1, 12), uni(-2, 2), uni(-3, 3), uni(-0.1, 0.1)};
+    const double u[2] = {uni(-0.99, 0.99), uni(-0.99, 0.65)};
+    double d1[7], d2[7];
+    reference.derivatives(x, u, d1);
+    model.derivatives(x, u, d2);
+    const double kinematic = x[st::kVx] * x[st::kYawRate];
+    CHECK(d2[st::kVy] == Approx(0.6 * (d1[st::kVy] + kinematic) - kinematic).margin(1e-6));
+    CHECK(d2[st::kYawRate] == Approx(0.6 * d1[st::kYawRate]).margin(1e-6));
+    for (int i : {st::kX, st::kY, st::kYaw, st::kVx, st::kRoll}) CHECK(d2[i] == d1[i]);
+  }
+
+  // The float step agrees with the double derivatives (Euler), and a scale set back to 1 gives
+  // the network's own numbers bit for bit.
+  constexpr int W = 16;
+  std::vector<float> x(7 * W), u(2 * W), scratch(model.scratch_floats(W));
+  for (int j = 0; j < W; ++j) {
+    const float lib[7] = {0.f, 0.f, 0.3f, static_cast<float>(uni(2, 10)), static_cast<float>(uni(-1, 1)),
+                          static_cast<float>(uni(-2, 2)), 0.01f};
+    for (int i = 0; i < 7; ++i) x[i * W + j] = lib[i];
+    u[j] = static_cast<float>(uni(-0.9, 0.9));
+    u[W + j] = static_cast<float>(uni(-0.5, 0.6));
+  }
+  std::vector<float> scaled = x, same = x, own = x;
+  model.step<W>(mppi::Batch<7, W>{scaled.data()}, mppi::ConstBatch<2, W>{u.data()}, 0.02f, scratch.data());
+  for (int j = 0; j < W; ++j) {
+    double xs[7], us[2] = {u[j], u[W + j]}, d[7];
+    for (int i = 0; i < 7; ++i) xs[i] = x[i * W + j];
+    model.derivatives(xs, us, d);
+    CHECK(scaled[st::kVy * W + j] == Approx(xs[st::kVy] + d[st::kVy] * 0.02).margin(1e-5));
+    CHECK(scaled[st::kYawRate * W + j] == Approx(xs[st::kYawRate] + d[st::kYawRate] * 0.02).margin(1e-5));
+  }
+  REQUIRE(model.set_param("lateral_force_scale", 1.0, &why));
+  model.step<W>(mppi::Batch<7, W>{same.data()}, mppi::ConstBatch<2, W>{u.data()}, 0.02f, scratch.data());
+  reference.step<W>(mppi::Batch<7, W>{own.data()}, mppi::ConstBatch<2, W>{u.data()}, 0.02f, scratch.data());
+  CHECK(same == own);
+
+  CHECK_FALSE(model.set_param("grip", 0.5, &why));
+  CHECK_THAT(why, Catch::Contains("grip") && Catch::Contains("lateral_force_scale"));
+  CHECK_FALSE(model.set_param("lateral_force_scale", 0.05, &why));
+  CHECK_THAT(why, Catch::Contains("lateral_force_scale must be in"));
+  CHECK_FALSE(model.set_param("lateral_force_scale", std::nan(""), &why));
+  CHECK(model.lateral_force_scale() == 1.f);
+}

@@ -79,6 +79,21 @@ TEST_CASE("step() allocates nothing for a model with effects", "[core][mppi][all
   CHECK(step_allocations(controller, model) == 0);
 }
 
+TEST_CASE("step() allocates nothing with the grip adaptation scaling the network and the speed",
+          "[core][mppi][alloc][adaptation]") {
+  const auto model = mppi::models::AutoRallyNetworkModel::load(default_data(mppi::models::AutoRallyNetworkModel::kDefaultFile));
+  mppi::ControllerOptions o = small_options();
+  o.force_adaptation.enabled = true;
+  o.force_adaptation.scale_model = true;
+  auto controller = mppi::make_cpu_controller(model, gazebo_cost(), o);
+  REQUIRE(controller.set_cost_param("target_speed_mps", 8.0));
+  // The same start state each step: the car "did not move" as the model said, so the fitted
+  // scale moves and the model and the target speed change with it.
+  CHECK(step_allocations(controller, model) == 0);
+  CHECK(controller.lateral_force_scale() != 1.f);
+  CHECK(controller.governed_speed() == Approx(8.0 * controller.lateral_force_scale()).epsilon(0.01));
+}
+
 TEST_CASE("step() allocates nothing on the Vulkan backend", "[core][mppi][alloc][vulkan]") {
   const mppi::SingleTrack model;
   mppi::BackendReport report;

@@ -69,8 +69,14 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.nominal_resets = 7;
   s.mean_abs_steer_step = 0.0625;
   s.mean_abs_throttle_step = 0.03125;
+  s.lateral_force_adaptation = true;
+  s.lateral_force_scale_final = 0.625;
+  s.lateral_force_scale_p50 = 0.75;
   const auto j = nlohmann::json::parse(to_json(s));
-  CHECK(j.size() == 38);
+  CHECK(j.size() == 41);
+  CHECK(j.at("lateral_force_adaptation") == true);
+  CHECK(j.at("lateral_force_scale_final") == 0.625);
+  CHECK(j.at("lateral_force_scale_p50") == 0.75);
   CHECK(j.at("limit_lap_method") == "collocation");
   CHECK(nlohmann::json::parse(to_json(RunSummary{})).at("limit_lap_method").is_null());
   CHECK(j.at("variant") == "tube");
