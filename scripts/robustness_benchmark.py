@@ -24,6 +24,7 @@ import csv
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 import time
@@ -220,12 +221,17 @@ def finite(values):
     return [v for v in values if v is not None and math.isfinite(v)]
 
 
-def reduce_cell(summaries):
-    """The figures of one cell from its runs' summaries."""
+def reduce_cell(summaries, limit_lap_s=None):
+    """The figures of one cell from its runs' summaries; the lap ratios against limit_lap_s where
+    given (the limit lap by collocation), else against the runs' own (mppi-sim's default, QSS)."""
     laps = [t for s in summaries for t in finite(s['lap_times_s'])]
-    ratios = [r for s in summaries for r in finite(s['lap_time_ratio'])]
-    limits = finite([s['limit_lap_s'] for s in summaries])
-    limit_lap_s = limits[0] if limits else float('nan')
+    if limit_lap_s is None:
+        ratios = [r for s in summaries for r in finite(s['lap_time_ratio'])]
+        limits = finite([s['limit_lap_s'] for s in summaries])
+        limit_lap_s = limits[0] if limits else float('nan')
+    else:
+        ratios = [t / limit_lap_s for t in laps] if math.isfinite(limit_lap_s) else []
+        limits = [limit_lap_s] if math.isfinite(limit_lap_s) else []
     return {
         'runs': len(summaries),
         'laps': len(laps),
@@ -245,13 +251,48 @@ def reduce_cell(summaries):
     }
 
 
-def reduce_cells(runs):
-    grouped = {}
+def reduce_cells(runs, limit_laps=None):
+    """limit_laps: (track, plant) -> limit lap [s] (collocation_limit_laps), or None for the runs' own."""
+    grouped, track_of = {}, {}
     for run in runs:
         if os.path.exists(run.summary_path):
             with open(run.summary_path) as f:
                 grouped.setdefault((run.group, run.plant, run.variant), []).append(json.load(f))
-    return {key: reduce_cell(summaries) for key, summaries in grouped.items()}
+            track_of[run.group] = run.track
+    return {key: reduce_cell(summaries, None if limit_laps is None else limit_laps[(track_of[key[0]], key[1])])
+            for key, summaries in grouped.items()}
+
+
+LAP_TIME_LINE = re.compile(r'^lap time\s+([0-9.]+) s', re.MULTILINE)
+
+
+def collocation_limit_laps(mppi_sim, groups, plants, out):
+    """(track, plant) -> the limit lap by collocation (docs/LIMIT_LAP.md) of the plant row's car
+    on the track, from `mppi-sim --limit-lap --limit-lap-method collocation`; NaN where it finds
+    none. Kept in OUT/limit_laps_collocation.json and read from there on a rerun."""
+    cache_path = os.path.join(out, 'limit_laps_collocation.json')
+    cache = {}
+    if os.path.exists(cache_path):
+        with open(cache_path) as f:
+            cache = json.load(f)
+    limits = {}
+    for _, track, _, _ in groups:
+        for plant in plants:
+            key = f'{track}|{plant}'
+            if key not in cache:
+                work = os.path.join(out, 'limit_laps', track, plant)
+                command = [mppi_sim, '--limit-lap', '--limit-lap-method', 'collocation', '--track', track,
+                           *PLANT_ROWS[plant], '--out', work]
+                start = time.monotonic()
+                done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True)
+                match = LAP_TIME_LINE.search(done.stdout)
+                cache[key] = float(match.group(1)) if done.returncode == 0 and match else float('nan')
+                print(f'limit lap by collocation, {track} / {plant}: {cache[key]:.3f} s '
+                      f'({time.monotonic() - start:.0f} s)', flush=True)
+                with open(cache_path, 'w') as f:
+                    json.dump(cache, f, indent=1)
+            limits[(track, plant)] = cache[key]
+    return limits
 
 
 def faster_than_limit(cell):
@@ -423,6 +464,9 @@ def main():
     parser.add_argument('--out', default='results/robustness', help='run folders and the figure JSON')
     parser.add_argument('--bin', default='build/bin', help='folder of mppi-sim and mppi-plot')
     parser.add_argument('--variants-file', default=VARIANTS_FILE)
+    parser.add_argument('--limit-lap-method', choices=['runs', 'collocation'], default='runs',
+                        help='the limit lap the laps are measured against: the runs\' own (mppi-sim\'s '
+                             'default, QSS) or the car\'s by collocation, solved once per track and plant row')
     parser.add_argument('--report', help='folder of robustness.md / .csv / .png (default: docs/results; '
                                          'with --quick: the --out folder)')
     args = parser.parse_args()
@@ -461,11 +505,16 @@ def main():
             failures = run_all_on_dask(runs, os.path.abspath(args.bin), args.dask or None, args.workers, args.out)
         except RuntimeError as e:  # mppi_tools' ToolError: a bad address, an unreachable scheduler
             sys.exit(f'robustness_benchmark: {e}')
-    cells = reduce_cells(runs)
+    limit_laps = None
+    if args.limit_lap_method == 'collocation':
+        limit_laps = collocation_limit_laps(mppi_sim, groups, plants, args.out)
+    cells = reduce_cells(runs, limit_laps)
 
     mode = 'quick (--quick)' if args.quick else 'full'
     mode_line = (f'Mode: {mode}; {len(runs)} runs; mppi-sim defaults otherwise (K 1920, T 100, CPU backend '
-                 f'where there is no GPU); run folders under `{args.out}/runs/`.')
+                 f'where there is no GPU); run folders under `{args.out}/runs/`; limit laps by '
+                 + ('collocation (`--limit-lap-method collocation`)' if limit_laps is not None else
+                    'the runs\' own method (mppi-sim\'s default, QSS)') + '.')
     os.makedirs(report_dir, exist_ok=True)
     os.makedirs(args.out, exist_ok=True)
     md_path = os.path.join(report_dir, 'robustness.md')
