@@ -81,9 +81,10 @@ struct ControllerOptions {
   // each channel's command and the model's input; empty = the model takes the command directly.
   std::vector<ActuatorChannel> actuators;
 
-  // Online adaptation of the model's lateral tyre force to the measured motion
-  // (mppi/lateral_force_adaptation.hpp); the model must have the parameter
-  // "lateral_force_scale" (the AutoRally network) and the backend must change it (CPU).
+  // Online grip adaptation (mppi/lateral_force_adaptation.hpp): the fitted scale of the model's
+  // lateral tyre force sets the cost's target speed and the throttle's upper limit (the
+  // controller's options().control_max follows it), and with scale_model the model's parameter
+  // "lateral_force_scale" (the AutoRally network). Needs a backend that steps the model (CPU).
   LateralForceAdaptation force_adaptation;
 
   // Checks against a model with `num_controls` channels; on failure writes why.
