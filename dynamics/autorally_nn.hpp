@@ -62,7 +62,7 @@ class AutoRallyNetwork {
   // mppi/lateral_force_adaptation.hpp). The network's d vy/dt is the tyres' lateral force per
   // mass minus the kinematic term vx r, and its d r/dt the tyres' yaw moment per inertia; the
   // scale s multiplies both force terms and keeps the kinematic one:
-  //   d vy/dt = net_vy + (s - 1) (net_vy + vx r),   d r/dt = net_r + (s - 1) net_r.
+  //   d vy/dt = net_vy + (s - 1) (net_vy + vx r),   d r/dt = s net_r.
   // A friction change that scales the whole tyre curve (Pacejka D) scales both by the same s.
   // s = 1 (the default) leaves every number as the network gives it, bit for bit.
   static constexpr std::string_view kLateralForceScaleKey = kLateralForceScaleParam;
@@ -113,7 +113,7 @@ class AutoRallyNetwork {
       proll[j] += d_roll[j] * dt_s;
       pvx[j] = vx + d_vx[j] * dt_s;
       pvy[j] = vy + (d_vy[j] + extra_force * (d_vy[j] + vx * r)) * dt_s;
-      pr[j] = r + (d_r[j] + extra_force * d_r[j]) * dt_s;
+      pr[j] = r + lateral_force_scale_ * d_r[j] * dt_s;
     }
   }
 

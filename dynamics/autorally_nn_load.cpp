@@ -58,7 +58,7 @@ void AutoRallyNetwork::derivatives(const double* x, const double* u, double* dx)
   dx[state::kVx] = out[1];
   const double extra_force = static_cast<double>(lateral_force_scale_) - 1.0;
   dx[state::kVy] = out[2] + extra_force * (out[2] + vx * x[state::kYawRate]);
-  dx[state::kYawRate] = out[3] + extra_force * out[3];
+  dx[state::kYawRate] = static_cast<double>(lateral_force_scale_) * out[3];
 }
 
 bool AutoRallyNetwork::set_param(std::string_view key, double value, std::string* why) {

@@ -260,18 +260,13 @@ class Controller {
   // With the lateral force adaptation on, its speed parameter (options().force_adaptation
   // .speed_param) is the requested speed: the cost gets it x scale^speed_exponent.
   bool set_cost_param(std::string_view key, double value, std::string* why = nullptr) {
+    const double requested = value;
+    if (governs(key)) value *= speed_factor();
+    if (!guarded(why, [&] { return backend_->set_cost_param(key, value, why); })) return false;
     if (governs(key)) {
-      const double requested = value;
-      value *= speed_factor();
-      if (!guarded(why, [&] { return backend_->set_cost_param(key, value, why); })) return false;
       requested_speed_ = requested;
       governed_speed_ = value;
-      if (feedback_backend_ && !guarded(why, [&] { return feedback_backend_->set_cost_param(key, value, why); }))
-        return false;
-      remember_cost_param(key, value);
-      return true;
     }
-    if (!guarded(why, [&] { return backend_->set_cost_param(key, value, why); })) return false;
     if (feedback_backend_ && !guarded(why, [&] { return feedback_backend_->set_cost_param(key, value, why); }))
       return false;
     remember_cost_param(key, value);
