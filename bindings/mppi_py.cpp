@@ -216,6 +216,10 @@ PYBIND11_MODULE(mppi, m) {
                     }, "plain | tube | robust")
       .def_readwrite("tube_reset_distance", &mppi::ControllerOptions::tube_reset_distance)
       .def_readwrite("robust_cost_margin", &mppi::ControllerOptions::robust_cost_margin)
+      .def_readwrite("robust_augmented_sampling", &mppi::ControllerOptions::robust_augmented_sampling,
+                     "robust: RMPPI's augmented sampling (the real system rolled out in every sample)")
+      .def_readwrite("robust_cost_bound", &mppi::ControllerOptions::robust_cost_bound,
+                     "robust_augmented_sampling: the most a real-system rollout may cost (inf: unbounded)")
       .def_property("ancillary_q",
                     [](const mppi::ControllerOptions& o) { return o.ancillary.q_diag; },
                     [](mppi::ControllerOptions& o, const std::vector<float>& q) { o.ancillary.q_diag = q; },
@@ -251,6 +255,7 @@ PYBIND11_MODULE(mppi, m) {
       .def_readonly("tube_distance", &mppi::StepSummary::tube_distance)
       .def_readonly("nominal_reset", &mppi::StepSummary::nominal_reset)
       .def_readonly("feedback_applied", &mppi::StepSummary::feedback_applied)
+      .def_readonly("augmented_sampling", &mppi::StepSummary::augmented_sampling)
       .def_readonly("optimizer_ms", &mppi::StepSummary::optimizer_ms);
 
   py::class_<mppi::VehicleState>(m, "VehicleState", "common vehicle state (ISO 8855, SI units)")

@@ -156,6 +156,14 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
                    "for the measured state to be taken [cost units]")
       ->type_name("C")
       ->check(CLI::NonNegativeNumber);
+  app.add_flag("--robust-augmented", mppi.robust_augmented_sampling,
+               "robust: RMPPI's augmented sampling: every sample also rolls out the real system from the measured "
+               "state under the feedback, and is scored by both rollouts (CPU backend)");
+  add_float_option(app, "--robust-cost-bound", mppi.robust_cost_bound,
+                   "robust with --robust-augmented: the most a sample's real-system rollout may cost (RMPPI's "
+                   "bound; default inf: unbounded) [cost units]")
+      ->type_name("C")
+      ->check(CLI::PositiveNumber);
   add_float_list_option(app, "--ancillary-q", mppi.ancillary.q_diag,
                         "tube / robust: the feedback's state weights, comma-separated, one per model state "
                         "(empty: 1 each)")

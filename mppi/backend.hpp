@@ -4,6 +4,7 @@
 // costs are templates inlined over structure-of-arrays batches (see cpu_backend.hpp).
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
@@ -25,6 +26,22 @@ struct RolloutShape {
   int num_controls = 0;        // model control size
 };
 
+// Robust MPPI's augmented sampling (Gandhi et al. 2021; ControllerOptions::
+// robust_augmented_sampling). Beside each sample's rollout from IterationInput::x0 (the nominal
+// state), the real system is rolled out from real_x0 under the sample's controls plus the
+// ancillary feedback on its distance from that sample's own nominal rollout:
+//   u_real_t = clamp(V_t + K_t (x_real_t - x_nom_t)),
+// and the sample's cost is
+//   S = 0.5 J_nom + 0.5 max(min(J_real, real_cost_bound), J_nom) + control cost,
+// so that a sequence the real car cannot follow from where it is costs more, while the bound
+// keeps one hopeless real rollout from swamping the rest. Off when real_x0 is empty.
+struct AugmentedSampling {
+  std::span<const float> real_x0;  // num_states: the measured state
+  std::span<const float> gains;    // T x nu x nx, row-major: K_t along the plan
+  float real_cost_bound = std::numeric_limits<float>::infinity();
+  bool enabled() const { return !real_x0.empty(); }
+};
+
 // One whole MPPI iteration done by the backend (a GPU backend: sampling, rollouts and the
 // weighted update without round trips). Inputs as in Controller; see Backend::iterate().
 struct IterationInput {
@@ -39,6 +56,7 @@ struct IterationInput {
   std::uint32_t iteration = 0;         // Philox counter word 2
   NoiseFilter noise_filter;            // the sampler's recursion over the normals (white: none)
   ActuatorPlan actuators;              // the actuators between command and model (none: off)
+  AugmentedSampling augmented;         // Robust MPPI's real-system rollouts (none: off)
 };
 struct IterationOutput {
   std::span<float> next;     // T x nu: sum_k w_k V_k (before smoothing)
@@ -77,6 +95,8 @@ class Backend {
   virtual bool has_iterate() const { return false; }
   // True if iterate() rolls out through IterationInput::actuators.
   virtual bool supports_actuators() const { return false; }
+  // True if iterate() rolls out the real system of IterationInput::augmented.
+  virtual bool supports_augmented_sampling() const { return false; }
   // Samples V_k = clamp(U + eps_k) with the Philox numbers of mppi/noise.hpp, rolls out, and
   // forms the weights and the weighted sum, as Controller does on the CPU.
   virtual void iterate(const IterationInput& /*in*/, IterationOutput& /*out*/) {}

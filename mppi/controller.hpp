@@ -59,6 +59,9 @@ struct StepSummary {
   float tube_distance = 0.f;
   bool nominal_reset = false;
   bool feedback_applied = false;     // the ancillary gains were computed and applied
+  // Robust MPPI with robust_augmented_sampling: the samples were also rolled out as the real
+  // system under the feedback (not at the first step, which has no gains yet)
+  bool augmented_sampling = false;
   // Online adaptation (ControllerOptions::force_adaptation): the estimated scale of the model's
   // lateral force this step planned with (1 when the adaptation is off).
   float lateral_force_scale = 1.f;
@@ -158,6 +161,13 @@ class Controller {
       float unused = 0.f;
       linearising_backend()->ancillary_gains(nominal_state_, nominal_, options_.ancillary, nominal_states_, gains_, nullptr);
       linearising_backend()->plan_cost(nominal_state_, nominal_, &unused, nullptr);
+      if (options_.robust_augmented_sampling) {
+        if (!backend_->supports_augmented_sampling())
+          throw Error(std::string("ControllerOptions: robust_augmented_sampling needs a backend that rolls out the "
+                                  "real system inside every sample (the CPU backend); the ") +
+                      backend_->name() + " backend does not");
+        sampling_gains_.assign(gains_.size(), 0.f);
+      }
     }
     if (!options_.actuators.empty()) {
       if (!backend_->supports_actuators())
@@ -309,6 +319,7 @@ class Controller {
     step_index_ = 0;
     actuator_state_ = ActuatorState{};
     have_nominal_state_ = false;
+    have_sampling_gains_ = false;
     adapt_have_previous_ = false;
   }
 
@@ -456,8 +467,10 @@ class Controller {
     }
     if (!ok) {
       have_nominal_state_ = false;
+      have_sampling_gains_ = false;
       return;
     }
+    keep_sampling_gains();
     for (int c = 0; c < nu_; ++c) {
       double u = output_[c];
       for (int i = 0; i < nx_; ++i)
@@ -467,6 +480,17 @@ class Controller {
     }
     std::copy_n(nominal_states_.begin() + nx_, nx_, nominal_state_.begin());
     sum.feedback_applied = true;
+  }
+
+  // Augmented sampling: the next step's samples run the feedback along the plan shifted by one
+  // step, as the plan is, so they use these gains shifted the same way (the last one repeated).
+  void keep_sampling_gains() noexcept {
+    if (sampling_gains_.empty()) return;
+    const std::size_t per_step = static_cast<std::size_t>(nu_) * nx_;
+    std::copy(gains_.begin() + static_cast<std::ptrdiff_t>(per_step), gains_.end(), sampling_gains_.begin());
+    std::copy(gains_.end() - static_cast<std::ptrdiff_t>(per_step), gains_.end(),
+              sampling_gains_.end() - static_cast<std::ptrdiff_t>(per_step));
+    have_sampling_gains_ = true;
   }
 
   // weights_ <- exp(-(S_k - min_cost) / lambda) / eta over costs_ (0 where not finite);
@@ -521,6 +545,10 @@ class Controller {
     in.lambda = lambda_;
     in.noise_filter = noise_filter_;
     if (!actuator_steps_.empty()) in.actuators = {actuator_steps_.data(), &actuator_state_};
+    if (have_sampling_gains_) {
+      in.augmented = {measured_, sampling_gains_, options_.robust_cost_bound};
+      sum.augmented_sampling = true;
+    }
     IterationOutput out;
     out.next = next_;
     out.costs = costs_;
@@ -758,6 +786,9 @@ class Controller {
   std::vector<float> measured_;        // nx: this step's measured state
   std::vector<float> nominal_states_;  // (T + 1) x nx along the last plan
   std::vector<float> gains_;           // T x nu x nx
+  // robust_augmented_sampling: the gains the next step's samples use (T x nu x nx)
+  std::vector<float> sampling_gains_;
+  bool have_sampling_gains_ = false;
   // the model's input until the next step (nu): the command sent, after the actuators
   std::vector<float> acting_input_;
   // online adaptation (options_.force_adaptation)

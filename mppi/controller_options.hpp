@@ -3,6 +3,7 @@
 // noise std 0.275 steering / 0.3 throttle, steering +-0.99, throttle [-0.99, 0.65]).
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -29,7 +30,10 @@ enum class ThreadSchedule { kWorkStealing, kDynamic, kStatic };
 //            measured one when their weighted distance exceeds tube_reset_distance.
 //   kRobust  Robust MPPI's choice of the nominal state (Gandhi et al. 2021): at every step the
 //            measured state replaces the nominal one unless the plan costs more from it than
-//            from the nominal state by more than robust_cost_margin; feedback as kTube.
+//            from the nominal state by more than robust_cost_margin; feedback as kTube. With
+//            robust_augmented_sampling, also RMPPI's augmented sampling: every sample rolls out
+//            the real system from the measured state under the feedback as well, and is
+//            scored by both rollouts (AugmentedSampling in mppi/backend.hpp).
 enum class ControllerVariant { kPlain, kTube, kRobust };
 
 inline const char* variant_name(ControllerVariant v) {
@@ -76,6 +80,10 @@ struct ControllerOptions {
   AncillaryWeights ancillary;            // the LQR's Q, R along the plan
   float tube_reset_distance = 2.0f;      // sqrt((x - x_nom)' Q (x - x_nom)) that resets the nominal state
   float robust_cost_margin = 0.0f;       // kRobust: cost the measured state may add [cost units]
+  bool robust_augmented_sampling = false;  // kRobust: RMPPI's real-system rollout in every sample
+  // RMPPI's bound on a sample's real-system cost [cost units]: one real rollout the feedback
+  // cannot save then costs no more than this (inf: unbounded)
+  float robust_cost_bound = std::numeric_limits<float>::infinity();
 
   // Actuator-aware planning (mppi/actuator_chain.hpp): the delay, rate limit and lag between
   // each channel's command and the model's input; empty = the model takes the command directly.
@@ -142,6 +150,9 @@ struct ControllerOptions {
       if (!(robust_cost_margin >= 0.f) || !std::isfinite(robust_cost_margin))
         return fail("robust_cost_margin must be >= 0 and finite");
     }
+    if (robust_augmented_sampling && variant != ControllerVariant::kRobust)
+      return fail(std::string("robust_augmented_sampling needs the robust variant, got ") + variant_name(variant));
+    if (!(robust_cost_bound > 0.f)) return fail("robust_cost_bound must be > 0 (inf: unbounded)");
     return true;
   }
 };

@@ -76,6 +76,10 @@ struct IterationArgs {
   int num_samples, padded, horizon;
   NoiseFilter filter;
   ActuatorPlan actuators;
+  // Robust MPPI's augmented sampling (AugmentedSampling; used by iterate_chunk<..., true>)
+  const float* real_x0 = nullptr;  // num_states
+  const float* gains = nullptr;    // T x nu x nx
+  float real_cost_bound = 0.f;
 };
 
 // partial[r] = sum_j e[j] v[r * padded + j], j in [0, kChunk), for r in [0, rows): the chunk's
@@ -146,6 +150,28 @@ inline void chunk_partial_sums(const float* e, const float* v, std::size_t padde
   chunk_partial_sums_portable(e, v, padded, 0, rows, partial);
 }
 
+// The real system's input in Robust MPPI's augmented sampling, per lane j:
+//   u_real[c][j] = clamp(u[c][j] + sum_i k[c * Nx + i] (x_real[i][j] - x_nom[i][j]), lo[c], hi[c])
+// (k: the T-step's nu x nx gains). A NaN stays NaN.
+template <int Nx, int Nu, int W>
+inline void feedback_controls(const float* k, const float* u, const float* x_real, const float* x_nom,
+                              const float* lo, const float* hi, float* u_real) noexcept {
+  for (int c = 0; c < Nu; ++c) {
+    float* out = u_real + c * W;
+    std::copy_n(u + c * W, W, out);
+    for (int i = 0; i < Nx; ++i) {
+      const float gain = k[c * Nx + i];
+      const float* xr = x_real + i * W;
+      const float* xn = x_nom + i * W;
+      MPPI_SIMD_LOOP
+      for (int j = 0; j < W; ++j) out[j] += gain * (xr[j] - xn[j]);
+    }
+    const float l = lo[c], h = hi[c];
+    MPPI_SIMD_LOOP
+    for (int j = 0; j < W; ++j) out[j] = out[j] < l ? l : (out[j] > h ? h : out[j]);
+  }
+}
+
 // One chunk of samples [k0, k0 + kChunk) of a whole iteration, fused so that each time step's
 // noise and controls are used while they are in L1: per pair of steps t, t + 1 draw
 // V = clamp(U + eps) for both (sample_step_pair, the numbers of Controller's sampling pass; one
@@ -157,21 +183,30 @@ inline void chunk_partial_sums(const float* e, const float* v, std::size_t padde
 //   e_k = exp(-(S_k - m_c) / lambda),  partial[t * nu + c] = sum_k e_k V_k,t,c
 // (the caller rescales by exp(-(m_c - min S) / lambda): the same weights as the two-pass form,
 // up to rounding). costs, expw: the chunk's S_k and e_k (k - k0 in [0, kChunk)).
-// work: (D::kNx + T * D::kNu) * kChunk + model scratch floats.
-template <class D, class C>
+// With kAugmented (Robust MPPI's augmented sampling, AugmentedSampling) each lane also rolls
+// out the real system from a.real_x0 under clamp(V_t + K_t (x_real_t - x_t)), x_t the lane's
+// own nominal rollout, and S_k = 0.5 J_nom + 0.5 max(min(J_real, bound), J_nom) + control cost.
+// work: (2 D::kNx + T * D::kNu) * kChunk + model scratch floats.
+template <class D, class C, bool kAugmented = false>
 MPPI_MULTIVERSION void iterate_chunk(const D& model, const C& cost, const IterationArgs& a,
                                      int k0, float* work, float* costs,
                                      float* expw, float* partial, ChunkTotals* totals) noexcept {
   constexpr int W = kChunk;
   constexpr int Nu = D::kNu;
+  constexpr int Nx = D::kNx;
   float* x = work;             // kNx x W
-  float* v = x + D::kNx * W;   // T x kNu x W: the chunk's sampled controls
-  float* scratch = v + static_cast<std::size_t>(a.horizon) * Nu * W;
+  float* v = x + Nx * W;       // T x kNu x W: the chunk's sampled controls
+  float* x_real = v + static_cast<std::size_t>(a.horizon) * Nu * W;  // kNx x W (kAugmented)
+  float* scratch = x_real + Nx * W;
   alignas(64) float state_cost[W] = {};
   alignas(64) float control_cost[W] = {};
   alignas(64) float eps_state[Nu * W];  // the sampler's state per channel and lane
   alignas(64) float actuator_rate[Nu * W], actuator_lag[Nu * W], applied[Nu * W];
-  for (int i = 0; i < D::kNx; ++i) std::fill_n(x + i * W, W, a.x0[i]);
+  alignas(64) float real_cost[W] = {};
+  alignas(64) float u_real[Nu * W];
+  for (int i = 0; i < Nx; ++i) std::fill_n(x + i * W, W, a.x0[i]);
+  if constexpr (kAugmented)
+    for (int i = 0; i < Nx; ++i) std::fill_n(x_real + i * W, W, a.real_x0[i]);
   const float valid_lanes = static_cast<float>(a.num_samples - k0);
   for (int t = 0; t < a.horizon; ++t) {
     if (t % 2 == 0) {
@@ -187,9 +222,25 @@ MPPI_MULTIVERSION void iterate_chunk(const D& model, const C& cost, const Iterat
                                  actuator_rate, actuator_lag, applied);
       u = applied;
     }
-    model.template step<W>(Batch<D::kNx, W>{x}, ConstBatch<Nu, W>{u}, a.dt_s, scratch);
-    cost.template accumulate<D::kNx, Nu, W>(ConstBatch<D::kNx, W>{x}, ConstBatch<Nu, W>{u}, t,
-                                            state_cost);
+    if constexpr (kAugmented)  // the feedback on the states at t, before either steps
+      feedback_controls<Nx, Nu, W>(a.gains + static_cast<std::size_t>(t) * Nu * Nx, u, x_real, x, a.lo, a.hi,
+                                   u_real);
+    model.template step<W>(Batch<Nx, W>{x}, ConstBatch<Nu, W>{u}, a.dt_s, scratch);
+    cost.template accumulate<Nx, Nu, W>(ConstBatch<Nx, W>{x}, ConstBatch<Nu, W>{u}, t, state_cost);
+    if constexpr (kAugmented) {
+      model.template step<W>(Batch<Nx, W>{x_real}, ConstBatch<Nu, W>{u_real}, a.dt_s, scratch);
+      cost.template accumulate<Nx, Nu, W>(ConstBatch<Nx, W>{x_real}, ConstBatch<Nu, W>{u_real}, t, real_cost);
+    }
+  }
+  if constexpr (kAugmented) {
+    // 0.5 J_nom + 0.5 max(min(J_real, bound), J_nom), written so that a NaN J_real stays NaN
+    // (the sample is then dropped as any other non-finite one)
+    MPPI_SIMD_LOOP
+    for (int j = 0; j < W; ++j) {
+      const float bounded = real_cost[j] > a.real_cost_bound ? a.real_cost_bound : real_cost[j];
+      const float upper = bounded < state_cost[j] ? state_cost[j] : bounded;
+      state_cost[j] = 0.5f * state_cost[j] + 0.5f * upper;
+    }
   }
   // S_k (the same sum as Controller's two-pass update: rollout cost + control cost)
   alignas(64) float s[W];
@@ -302,9 +353,9 @@ class CpuBackend final : public Backend {
     static_assert(D::kNu <= detail::kMaxNoiseChannels, "the samplers filter at most kMaxNoiseChannels channels");
     shape_ = {num_samples, padded_sample_count(num_samples), horizon, D::kNx, D::kNu};
     threads_ = runner_.threads();
-    // state, the chunk's T steps of controls (iterate_chunk; rollout_chunk uses one), model
-    // scratch
-    work_floats_ = static_cast<std::size_t>(D::kNx + horizon * D::kNu) * kChunk +
+    // state, the chunk's T steps of controls (iterate_chunk; rollout_chunk uses one), the
+    // real system's state (augmented sampling), model scratch
+    work_floats_ = static_cast<std::size_t>(2 * D::kNx + horizon * D::kNu) * kChunk +
                    model_.scratch_floats(kChunk);
     // Round each thread's slice to a cache line (16 floats) so threads never share one.
     work_floats_ = (work_floats_ + 15) / 16 * 16;
@@ -367,14 +418,25 @@ class CpuBackend final : public Backend {
   // the chunks combined in order (detail::combine_chunks).
   bool has_iterate() const override { return true; }
   bool supports_actuators() const override { return true; }
+  bool supports_augmented_sampling() const override { return true; }
   void iterate(const IterationInput& in, IterationOutput& out) override {
     const int padded = shape_.padded_samples;
     const int chunks = padded / kChunk;
-    const detail::IterationArgs args{in.x0.data(), in.nominal.data(), in.noise_std.data(),
-                                     in.control_min.data(), in.control_max.data(), in.gamma,
-                                     1.f / in.lambda, dt_s_, NoiseKey{in.seed}, in.iteration,
-                                     shape_.num_samples, padded, shape_.horizon, in.noise_filter,
-                                     in.actuators};
+    detail::IterationArgs args{in.x0.data(), in.nominal.data(), in.noise_std.data(),
+                               in.control_min.data(), in.control_max.data(), in.gamma,
+                               1.f / in.lambda, dt_s_, NoiseKey{in.seed}, in.iteration,
+                               shape_.num_samples, padded, shape_.horizon, in.noise_filter,
+                               in.actuators};
+    const bool augmented = in.augmented.enabled();
+    if (augmented) {
+      if (in.augmented.real_x0.size() != static_cast<std::size_t>(D::kNx) ||
+          in.augmented.gains.size() != static_cast<std::size_t>(shape_.horizon) * D::kNu * D::kNx)
+        throw Error("cpu backend: augmented sampling needs real_x0 of num_states and gains of T x nu x nx");
+      if (in.actuators.enabled()) throw Error("cpu backend: augmented sampling rolls out without an actuator chain");
+      args.real_x0 = in.augmented.real_x0.data();
+      args.gains = in.augmented.gains.data();
+      args.real_cost_bound = in.augmented.real_cost_bound;
+    }
     remember_draw_inputs(in);
     float* work = work_.data();
     const std::size_t work_floats = work_floats_;
@@ -385,9 +447,14 @@ class CpuBackend final : public Backend {
     detail::ChunkTotals* totals = totals_.data();
     runner_.run(chunks, 1, [&](int chunk, int slot) {
       const int k0 = chunk * kChunk;
-      detail::iterate_chunk(model_, cost_, args, k0, work + work_floats * static_cast<std::size_t>(slot),
-                            costs + k0, expw + k0, partial + stride * static_cast<std::size_t>(chunk),
-                            totals + chunk);
+      float* chunk_work = work + work_floats * static_cast<std::size_t>(slot);
+      float* chunk_partial = partial + stride * static_cast<std::size_t>(chunk);
+      if (augmented)
+        detail::iterate_chunk<D, C, true>(model_, cost_, args, k0, chunk_work, costs + k0, expw + k0, chunk_partial,
+                                          totals + chunk);
+      else
+        detail::iterate_chunk<D, C, false>(model_, cost_, args, k0, chunk_work, costs + k0, expw + k0, chunk_partial,
+                                           totals + chunk);
     });
     detail::combine_chunks(totals, partial, stride, chunks, shape_.horizon * D::kNu,
                            shape_.num_samples, 1.f / in.lambda, expw, sums_.data(), scales_.data(), out);

@@ -29,6 +29,7 @@ class DeviceLossInjector final : public Backend {
     inner_->rollout(x0, controls, costs);
   }
   bool has_iterate() const override { return inner_->has_iterate(); }
+  bool supports_augmented_sampling() const override { return inner_->supports_augmented_sampling(); }
   void iterate(const IterationInput& in, IterationOutput& out) override {
     count_call();
     inner_->iterate(in, out);

@@ -10,7 +10,8 @@
 //                                sampling, 2 derivative-space (smooth) sampling, 3 adaptive
 //                                temperature (ESS 10 % of K), 4 actuator-aware (steering delay
 //                                0.04 s, lag 0.1 s, 5/s; throttle 10/s), 5 Tube-MPPI, 6 Robust
-//                                MPPI (nominal-state choice + feedback)
+//                                MPPI (nominal-state choice + feedback), 7 Robust MPPI with
+//                                augmented sampling (the real system rolled out in every sample)
 //   BM_MppiContention/threads:N/busy:B/schedule:S  the same step while B busy processes (started
 //                                and stopped by the benchmark) share the CPU; S: 0 work stealing
 //                                (oneTBB, the default), 1 OpenMP dynamic, 2 OpenMP static
@@ -180,6 +181,10 @@ void BM_VariantIteration(benchmark::State& state) {
     case 4: o.actuators = {{0.04f, 0.1f, 5.f}, {0.f, 0.f, 10.f}}; break;
     case 5: o.variant = mppi::ControllerVariant::kTube; break;
     case 6: o.variant = mppi::ControllerVariant::kRobust; break;
+    case 7:
+      o.variant = mppi::ControllerVariant::kRobust;
+      o.robust_augmented_sampling = true;
+      break;
     default: break;
   }
   mppi::Controller controller = mppi::make_cpu_controller(network(), make_cost(), o);
@@ -400,7 +405,7 @@ void thread_precision_args(benchmark::internal::Benchmark* b) {
 BENCHMARK(BM_MppiIteration)->Apply(thread_precision_args);
 BENCHMARK(BM_VariantIteration)
     ->ArgNames({"threads", "variant"})
-    ->ArgsProduct({{1, 2}, {0, 1, 2, 3, 4, 5, 6}})
+    ->ArgsProduct({{1, 2}, {0, 1, 2, 3, 4, 5, 6, 7}})
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 // threads x busy processes x schedule (0 work stealing, 1 OpenMP dynamic, 2 OpenMP static)

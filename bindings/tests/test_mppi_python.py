@@ -306,3 +306,28 @@ def test_tube_variant_publishes_its_gains():
     assert s.tube_distance == pytest.approx(0.1, rel=1e-3)
     with pytest.raises(mppi.Error, match="plain, tube or robust"):
         o.variant = "rmppi"
+
+
+def test_robust_augmented_sampling_from_python():
+    """Robust MPPI's augmented sampling is settable from Python: from the second step on the
+    samples are also rolled out as the real car; the tube variant refuses it by name."""
+    cmap = mppi.CostMap.load_npz(os.path.join(DATA, "autorally/maps/gazebo/gazebo_costmap.npz"))
+    cost = mppi.AutoRallyCost(cmap)
+    o = mppi.ControllerOptions()
+    o.num_samples = 256
+    o.num_threads = 1
+    o.variant = "robust"
+    o.robust_augmented_sampling = True
+    o.robust_cost_bound = 5000.0
+    c = mppi.Controller("kinematic", cost, o)
+    x = c.model_state(mppi.VehicleState(x_m=-8.5, y_m=-8.9, yaw_rad=2.356, vx_mps=5.0))
+    u, s = c.step(x)
+    assert s.feedback_applied and not s.augmented_sampling
+    x_meas = c.nominal_states[1].copy()
+    x_meas[0] += 0.1
+    u, s = c.step(x_meas)
+    assert s.status == mppi.StepStatus.OK and s.augmented_sampling
+    assert np.all(np.isfinite(u))
+    o.variant = "tube"
+    ok, why = o.is_valid(2)
+    assert not ok and "robust_augmented_sampling needs the robust variant" in why

@@ -89,6 +89,19 @@ TEST_CASE("Controller::step allocates nothing", "[core][mppi]") {
   controller.step(bad, &summary);
   counting = false;
   CHECK(allocations.load() == 0);
+  // The same with Robust MPPI and its augmented sampling (measured state off the nominal one).
+  o.variant = mppi::ControllerVariant::kRobust;
+  o.robust_augmented_sampling = true;
+  auto robust = mppi::make_cpu_controller(mppi::test::DoubleIntegrator{}, mppi::test::QuadraticCost{}, o);
+  robust.step(x0, &summary);
+  const float off[2] = {1.2f, 0.3f};
+  robust.step(off, &summary);
+  allocations = 0;
+  counting = true;
+  for (int i = 0; i < 10; ++i) robust.step(i % 2 ? x0 : off, &summary);
+  counting = false;
+  CHECK(summary.augmented_sampling);
+  CHECK(allocations.load() == 0);
   // The counter works: a vector allocation is seen.
   counting = true;
   std::vector<float> v(10);

@@ -81,6 +81,8 @@ _SETTERS = {
     'variant': lambda c, k, v: setattr(c.controller, 'variant', str(v)),
     'tube-reset': lambda c, k, v: setattr(c.controller, 'tube_reset_distance', _number(k, v)),
     'robust-margin': lambda c, k, v: setattr(c.controller, 'robust_cost_margin', _number(k, v)),
+    'robust-augmented': lambda c, k, v: setattr(c.controller, 'robust_augmented_sampling', _bool(k, v)),
+    'robust-cost-bound': lambda c, k, v: setattr(c.controller, 'robust_cost_bound', _number(k, v)),
     'actuator-model': lambda c, k, v: setattr(c, 'actuator_model', str(v)),
     'seed': lambda c, k, v: setattr(c.controller, 'seed', _number(k, v, int)),
     'threads': lambda c, k, v: setattr(c.controller, 'num_threads', _number(k, v, int)),
