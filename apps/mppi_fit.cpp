@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
   add_diagnose_command(app, commands);
   add_protocol_command(app, commands);
   add_calibrate_command(app, commands);
+  add_evaluate_command(app, commands);
   if (const int rc = mppi::cli::parse(app, argc, argv); rc >= 0) return rc;
   return commands.run();
 }

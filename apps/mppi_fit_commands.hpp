@@ -26,3 +26,4 @@ void add_convert_command(CLI::App& fit, FitCommands& commands);   // apps/mppi_f
 void add_diagnose_command(CLI::App& fit, FitCommands& commands);  // apps/mppi_fit_diagnose.cpp
 void add_protocol_command(CLI::App& fit, FitCommands& commands);  // apps/mppi_fit_protocol.cpp
 void add_calibrate_command(CLI::App& fit, FitCommands& commands);  // apps/mppi_fit_calibrate.cpp
+void add_evaluate_command(CLI::App& fit, FitCommands& commands);   // apps/mppi_fit_evaluate.cpp

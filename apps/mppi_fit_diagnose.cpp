@@ -13,6 +13,7 @@
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -78,7 +79,8 @@ void add_driver_speed_options(CLI::App& cmd, SynthOptions& o) {
 }
 
 struct DiagnoseArgs {
-  std::vector<std::string> logs, validates;
+  std::vector<std::string> logs, validates, tests;
+  double test_fraction = 0.0;
   std::string params, model = mppi::models::SingleTrackModel::kName, effects;
   DiagnoseOptions o;
   bool no_plots = false, quiet = false;
@@ -105,6 +107,26 @@ int cmd_diagnose(DiagnoseArgs& args) {
   // recording is held out and scored on its own.
   DiagData d = load_any(args.logs[0]);
   for (std::size_t i = 1; i < args.logs.size(); ++i) d = concat(d, load_any(args.logs[i]));
+  // The test data: the end of --log cut off before anything else sees it, and/or --test files.
+  std::optional<DiagData> test;
+  std::string test_name;
+  if (args.test_fraction > 0) {
+    const auto cut = static_cast<std::size_t>(std::lround(static_cast<double>(d.rows()) * (1.0 - args.test_fraction)));
+    char name[160];
+    std::snprintf(name, sizeof name, "the last %.0f %% of --log, t >= %.1f s", 100 * args.test_fraction, d.t[cut]);
+    test = slice_rows(d, cut, d.rows());
+    d = slice_rows(d, 0, cut);
+    test_name = name;
+  }
+  for (const auto& f : args.tests) {
+    const DiagData t = load_any(f);
+    test = test ? concat(*test, t) : t;
+    test_name += (test_name.empty() ? "" : " + ") + f;
+  }
+  if (test) {
+    o.test = &*test;
+    o.test_name = test_name;
+  }
   if (!args.validates.empty()) {  // fit on --log, judge on --validate
     const double first_t = d.t.back() + 5.0;  // concat leaves a 10 s gap before the next recording
     for (const auto& v : args.validates) {
@@ -128,8 +150,14 @@ int cmd_diagnose(DiagnoseArgs& args) {
     std::printf("  %s = %.4g +- %.2g %s\n", p.name.c_str(), p.value, p.stddev, p.unit.c_str());
   for (const auto& p : r.per_recording)
     std::printf("  held out %s: %.4f -> %.4f\n", p.name.c_str(), p.before, p.after);
-  std::printf("held-out normalised RMSE at 1 s: %.4f -> %.4f (%.1f %% reduction)\nreport: %s/report.md\n",
-              r.headline_before, r.headline_after, 100 * r.heldout_rmse_reduction, o.out_dir.c_str());
+  std::printf("held-out normalised RMSE at 1 s: %.4f -> %.4f (%.1f %% reduction)\n", r.headline_before,
+              r.headline_after, 100 * r.heldout_rmse_reduction);
+  if (test)
+    std::printf("test (%s; never seen by the fit or the validation): %.4f -> %.4f (%.1f %% reduction)%s\n",
+                test_name.c_str(), r.test_headline_before, r.test_headline_after,
+                100 * (r.test_headline_before > 0 ? 1.0 - r.test_headline_after / r.test_headline_before : 0.0),
+                r.selection.reliable ? "" : "; not written");
+  std::printf("report: %s/report.md\n", o.out_dir.c_str());
   return 0;
 }
 
@@ -355,6 +383,15 @@ void add_diagnose_options(CLI::App& cmd, DiagnoseArgs& a) {
                  "data/config files: pass --params data/config/autorally_single_track.yaml for the simulator's default plant)")
       ->type_name("FILE");
   cmd.add_option("--holdout", a.o.holdout, "held-out fraction at the end, or time range T0:T1 [s]")->type_name("H");
+  cmd.add_option("--test", a.tests,
+                 "score the correction afterwards on this recording, which neither the fit nor the validation sees "
+                 "(repeat to pool several)")
+      ->type_name("FILE");
+  cmd.add_option("--test-fraction", a.test_fraction,
+                 "cut this fraction off the end of --log first and score the correction on it afterwards (fit, "
+                 "validation and test split three ways)")
+      ->type_name("F")
+      ->check(CLI::Range(0.0, 0.9));
   cmd.add_option("--validate", a.validates,
                  "fit on all of --log, judge on this other recording (replaces --holdout); repeat for a cross-recording table")
       ->type_name("FILE");

@@ -12,6 +12,7 @@ DiagData prepare(const sim::Recording& rec, const std::string& source, std::size
                  const ScreenOptions& screen) {
   DiagData d;
   d.source = source;
+  d.metadata = rec.metadata;
   for (const auto& c : sim::kRecordingRequiredColumns)
     if (!rec.has_column(c)) throw Error(source + ": missing required column '" + c + "'");
   d.t = rec.column("t");
@@ -148,6 +149,27 @@ DiagData concat(const DiagData& a, const DiagData& b) {
   }
   d.screened_rows += b.screened_rows;
   return d;
+}
+
+DiagData slice_rows(const DiagData& d, std::size_t first, std::size_t last) {
+  if (!(first < last && last <= d.rows()))
+    throw Error(d.source + ": rows " + std::to_string(first) + ".." + std::to_string(last) + " are not a part of its " +
+                std::to_string(d.rows()) + " rows");
+  DiagData s = d;
+  auto cut = [&](std::vector<double>& v) {
+    if (!v.empty()) v = std::vector<double>(v.begin() + static_cast<std::ptrdiff_t>(first), v.begin() + static_cast<std::ptrdiff_t>(last));
+  };
+  for (auto* v : {&s.t, &s.x, &s.y, &s.yaw, &s.vx, &s.vy, &s.r, &s.steer, &s.throttle, &s.roll}) cut(*v);
+  s.piece = std::vector<int>(d.piece.begin() + static_cast<std::ptrdiff_t>(first), d.piece.begin() + static_cast<std::ptrdiff_t>(last));
+  s.flags.clear();
+  s.screened_rows = 0;
+  for (ScreenFlag f : d.flags)
+    if (f.row >= first && f.row < last) {
+      f.row -= first;
+      s.flags.push_back(std::move(f));
+    }
+  for (int p : s.piece) s.screened_rows += p < 0;
+  return s;
 }
 
 DiagData load_any(const std::string& spec) {

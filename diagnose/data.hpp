@@ -1,6 +1,7 @@
 #pragma once
 // A recording prepared for sim-vs-real diagnosis: the required columns as arrays, the split
 // into continuous pieces (gaps, NaNs and respawn jumps cut it), training / held-out parts.
+#include <map>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@ inline const char* const kChannelUnits[kChannels] = {"m/s", "m/s", "rad/s"};
 
 struct DiagData {
   std::string source;                       // file name, for messages
+  std::map<std::string, std::string> metadata;  // the recording's "# key: value" lines (vehicle, mass_kg, ...)
   std::vector<double> t, x, y, yaw, vx, vy, r, steer, throttle;
   // Optional `roll` column [rad] (empty when the recording has none): the start state of
   // models that carry roll (the AutoRally network takes it as an input).
@@ -49,6 +51,10 @@ DiagData prepare(const sim::Recording& rec, const std::string& source, std::size
 
 // Reads and prepares a recording file (sim::RecordingReader, then prepare()).
 DiagData load_recording(const std::string& path);
+
+// Rows [first, last) of d as a recording of their own (pieces and screening flags kept;
+// throws mppi::Error if the range is empty or beyond d).
+DiagData slice_rows(const DiagData& d, std::size_t first, std::size_t last);
 
 // Training recording followed by a validation recording (separate pieces, the second's times
 // shifted to follow the first); rows of `b` start at index a.rows().

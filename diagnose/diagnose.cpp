@@ -1,4 +1,5 @@
 #include "diagnose/diagnose.hpp"
+#include "diagnose/evaluate.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -126,12 +127,26 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
     const auto a = horizon_metrics(corrected, d, mask, {o.headline_horizon_s}, 5, o.replay);
     if (!b.empty() && !a.empty()) res.per_recording.push_back({part.name, b[0].normalized_rmse, a[0].normalized_rmse});
   }
+  // The test part: data the selection never saw, scored whatever the veto decided.
+  if (o.test) {
+    const std::vector<char> all(o.test->rows(), 1);
+    res.test_before = horizon_metrics(nominal_model, *o.test, all, hs, 5, o.replay);
+    res.test_after = horizon_metrics(corrected, *o.test, all, hs, 5, o.replay);
+    const HorizonMetrics* tb = at_horizon(res.test_before, o.headline_horizon_s);
+    const HorizonMetrics* ta = at_horizon(res.test_after, o.headline_horizon_s);
+    if (tb && ta) {
+      res.test_headline_before = tb->normalized_rmse;
+      res.test_headline_after = ta->normalized_rmse;
+    }
+  }
   // What is left: the corrected model's residuals, located on the held-out part.
   const ResidualSeries rs_after = residual_series(corrected, d, o.locate_horizon_s, o.replay);
   res.remaining = locate(d, rs_after, held);
 
   // 3. Model file.
   CorrectedModelFile file = nominal.file(res.selection.final_effects, res.selection.selected);
+  file.fitted_on = fitted_on_of(d);
+  file.fitted_on["heldout"] = o.holdout;
   // The controller has no clock of the recording: a grip change is written as the grip after it.
   if (file.effects.grip_change_time_s > 0 && file.effects.grip_scale != 1.0) {
     file.effects.grip_change_time_s = 0.0;
@@ -237,6 +252,18 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
     parts.push_back({{"recording", p.name}, {"normalized_rmse_before", num(p.before)}, {"normalized_rmse_after", num(p.after)},
                      {"reduction", num(p.before > 0 ? 1.0 - p.after / p.before : 0.0)}});
   j["per_recording"] = parts;
+  if (o.test) {
+    const double before = res.test_headline_before, after = res.test_headline_after;
+    j["test"] = {{"data", o.test_name.empty() ? o.test->source : o.test_name},
+                 {"rows", o.test->rows()},
+                 {"horizon_s", o.headline_horizon_s},
+                 {"normalized_rmse_before", num(before)},
+                 {"normalized_rmse_after", num(after)},
+                 {"reduction", num(before > 0 ? 1.0 - after / before : 0.0)},
+                 {"correction_written", res.selection.reliable},
+                 {"metrics_before", metrics_json(res.test_before)},
+                 {"metrics_after", metrics_json(res.test_after)}};
+  }
   j["metrics_before"] = metrics_json(res.before);
   j["metrics_after"] = metrics_json(res.after);
   j["selection_log"] = res.selection.log;
@@ -333,6 +360,17 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
               t << "| `" << p.name << "` | " << p.before << " | " << p.after << " | "
                 << 100 * (p.before > 0 ? 1.0 - p.after / p.before : 0.0) << " % |\n";
             return t.str() + "\n";
+          }()
+       << [&] {
+            if (!o.test) return std::string();
+            std::ostringstream t;
+            t.precision(4);
+            const double b = res.test_headline_before, a = res.test_headline_after;
+            t << "**Test** (" << (o.test_name.empty() ? o.test->source : o.test_name)
+              << ", data that neither the fit nor the validation saw): normalised RMSE at " << o.headline_horizon_s
+              << " s " << b << " -> " << a << " (" << 100 * (b > 0 ? 1.0 - a / b : 0.0) << " % reduction)"
+              << (res.selection.reliable ? "" : "; this correction was not written (no reliable correction)") << ".\n\n";
+            return t.str();
           }()
        << "## What is left\n\nShare of the held-out squared error at " << o.headline_horizon_s
        << " s that the correction explains:";

@@ -34,6 +34,11 @@ struct DiagnoseOptions {
     double t0_s = 0, t1_s = 0;
   };
   std::vector<Part> heldout_recordings;
+  // Data that neither the fit nor the validation (the held-out part, which also decides whether
+  // a correction is written) sees: the correction the selection arrived at is scored on it
+  // afterwards, written or not. nullptr = none. test_name names it in the report.
+  const DiagData* test = nullptr;
+  std::string test_name;
 };
 
 struct DiagnoseResult {
@@ -55,6 +60,10 @@ struct DiagnoseResult {
     double before = 0, after = 0;
   };
   std::vector<PartScore> per_recording;
+  // On DiagnoseOptions::test (empty without one): one-step, then the horizons, of the nominal and
+  // of the selection's corrected model; the normalised RMSE at the headline horizon.
+  std::vector<HorizonMetrics> test_before, test_after;
+  double test_headline_before = 0, test_headline_after = 0;
   std::string model_file;
   std::string json;                           // report.json text
 };

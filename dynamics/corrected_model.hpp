@@ -2,6 +2,7 @@
 // A corrected model as a file: a registered nominal model, its parameters and the effects
 // around it (WithEffects<Model>, dynamics/with_effects.hpp), as `mppi-fit diagnose` writes it
 // and `mppi-sim --model corrected` / `--plant corrected` read it.
+#include <map>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -30,6 +31,9 @@ struct CorrectedModelFile {
   std::string network_npz;            // nominal_model == autorally-nn ("" = the shipped network)
   EffectParams effects;
   std::vector<std::string> selected;  // effect ids (informational, `selected:` list)
+  // What the model was fitted on (`fitted_on:`, written by mppi-fit diagnose; informational
+  // except for mppi-fit evaluate's match check): source, vehicle, throttle_command, dt_s.
+  std::map<std::string, std::string> fitted_on;
 };
 // The registered models a corrected-model file can have as its nominal (the file has a
 // parameter section for each of them).

@@ -47,9 +47,13 @@ CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std:
     } else if (key == "selected") {
       if (!v.IsSequence()) throw Error(yaml_where(source, v.Mark()) + ": selected must be a list");
       for (const auto& s : v) out.selected.push_back(yaml_text(s, "an entry of selected", source));
+    } else if (key == "fitted_on") {
+      if (!v.IsMap()) throw Error(yaml_where(source, v.Mark()) + ": fitted_on must be a map of key: text");
+      for (const auto& f : v)
+        out.fitted_on[yaml_text(f.first, "a key of fitted_on", source)] = yaml_text(f.second, "a value of fitted_on", source);
     } else {
       throw Error(yaml_where(source, kv.first.Mark()) + ": unknown key '" + key +
-                  "' (valid: model, nominal, nominal_params, effects, selected)");
+                  "' (valid: model, nominal, nominal_params, effects, selected, fitted_on)");
     }
   }
   const std::string where = source + " (nominal_params)";
@@ -105,6 +109,15 @@ std::string corrected_model_to_yaml(const CorrectedModelFile& m, const std::stri
   for (std::size_t i = 0; i < fields.size(); ++i)
     if (fields[i].get() != default_fields[i].get()) eff << "  " << fields[i].key << ": " << fields[i].get() << "\n";
   o << (eff.str().empty() ? "effects: {}\n" : "effects:\n" + eff.str());
+  if (!m.fitted_on.empty()) {
+    YAML::Emitter fitted;  // quoted as YAML needs (file names may hold ':' or '#')
+    fitted << YAML::BeginMap;
+    for (const auto& [k, v] : m.fitted_on) fitted << YAML::Key << k << YAML::Value << YAML::DoubleQuoted << v;
+    fitted << YAML::EndMap;
+    std::istringstream fitted_lines(fitted.c_str());
+    o << "fitted_on:\n";
+    for (std::string line; std::getline(fitted_lines, line);) o << "  " << line << "\n";
+  }
   if (m.nominal_model == mppi::models::AutoRallyNetworkModel::kName) {
     o << "nominal_params:\n  network_npz: \"" << m.network_npz << "\"\n";
     return o.str();

@@ -14,6 +14,7 @@
 #include "dynamics/corrected_model.hpp"
 #include "dynamics/with_effects.hpp"
 #include "diagnose/diagnose.hpp"
+#include "diagnose/evaluate.hpp"
 #include "diagnose/identifiability.hpp"
 #include "diagnose/joint_refit.hpp"
 #include "diagnose/synth.hpp"
@@ -160,6 +161,21 @@ TEST_CASE("two hidden effects at once are both named, report and model file agre
   const CorrectedModelFile f = load_corrected_model(j["model_file"].get<std::string>());
   CHECK(f.effects.steer_delay_s == Approx(0.08).margin(0.01));
   CHECK(f.effects.throttle_lag_s == Approx(0.25).margin(0.04));
+  // mppi-fit evaluate on the written file and the same recording's held-out rows gives the
+  // diagnosis' held-out figures.
+  {
+    EffectParams truth;
+    parse_effect_assignments("steer_delay_s=0.08,throttle_lag_s=0.25", &truth);
+    const DiagData d = prepare(synthesize_open_loop(truth, 31, 20.0), "synthetic");
+    EvaluateOptions eo;
+    eo.rows = f.fitted_on.at("heldout");
+    const EvaluateResult e = evaluate_corrected_model(f, "corrected_model.yaml", d, eo);
+    CHECK(e.headline_nominal == Approx(r.headline_before).epsilon(1e-6));
+    CHECK(e.headline_corrected == Approx(r.headline_after).epsilon(1e-6));
+    REQUIRE(e.corrected.size() == r.after.size());
+    for (std::size_t i = 0; i < r.after.size(); ++i) CHECK(e.corrected[i].normalized_rmse == Approx(r.after[i].normalized_rmse).epsilon(1e-6));
+    CHECK(f.fitted_on.at("throttle_command") == "throttle");
+  }
   CHECK(std::filesystem::file_size(dir / "overlay.png") > 1000);
   CHECK(std::filesystem::file_size(dir / "residual_vs_regime.png") > 1000);
   // report.html: self-contained, its embedded figures are report.json's, in the report's order.
