@@ -55,6 +55,8 @@ ControllerOptions ControllerNodeSettings::options() const {
   o.seed = seed;
   parse_controller_variant(variant, &o.variant);
   o.force_adaptation.enabled = adapt_grip;
+  o.robust_augmented_sampling = robust_augmented;
+  o.robust_cost_bound = static_cast<float>(robust_cost_bound);
   return o;
 }
 

@@ -37,6 +37,9 @@ struct ControllerNodeSettings {
   std::string model_params;         // its data file; empty = the model's default
   std::string backend = "cpu";      // cpu | vulkan | auto
   std::string variant = "plain";    // plain | tube | robust
+  // robust: RMPPI's augmented sampling, with the real system's cost bounded (CPU backend)
+  bool robust_augmented = false;
+  double robust_cost_bound = 5000.0;
   // Online grip adaptation (mppi/lateral_force_adaptation.hpp): the target speed and the
   // throttle's limit follow the grip fitted from the measured motion (CPU backend).
   bool adapt_grip = false;

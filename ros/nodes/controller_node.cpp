@@ -87,6 +87,8 @@ int main(int argc, char** argv) {
     read_param(nh, "backend", s.backend);
     read_param(nh, "variant", s.variant);
     read_param(nh, "adapt_grip", s.adapt_grip);
+    read_param(nh, "robust_augmented", s.robust_augmented);
+    read_param(nh, "robust_cost_bound", s.robust_cost_bound);
     read_param(nh, "num_threads", s.num_threads);
     read_param(nh, "seed", seed);
     s.seed = static_cast<std::uint64_t>(seed);
