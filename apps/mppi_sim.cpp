@@ -54,11 +54,12 @@ int main(int argc, char** argv) {
   const mppi::sim::ClosedLoopConfig& config = cl.config;
   try {
     if (cl.limit_lap) {
-      const mppi::sim::LimitLap lap = mppi::sim::report_limit_lap(config);
+      const mppi::sim::LimitLaps laps = mppi::sim::report_limit_lap(config);
       std::printf("limit lap (%s) of the %s plant on %s%s:\n%s", config.limit_lap_method.c_str(), config.plant.c_str(), config.track.c_str(),
-                  config.clockwise ? " (clockwise)" : "", mppi::sim::describe_limit_lap(lap).c_str());
+                  config.clockwise ? " (clockwise)" : "", mppi::sim::describe_limit_laps(laps).c_str());
       if (!config.out_dir.empty())
-        std::printf("-> %s/limit_lap.csv, %s/limit_lap.png\n", config.out_dir.c_str(), config.out_dir.c_str());
+        std::printf("-> %s/limit_lap.csv, %s/limit_lap.png, %s/standing_limit_lap.csv\n", config.out_dir.c_str(),
+                    config.out_dir.c_str(), config.out_dir.c_str());
       return 0;
     }
 #ifdef MPPI_HAVE_OCS

@@ -498,6 +498,7 @@ PYBIND11_MODULE(mppi, m) {
       .def_readonly("laps_completed", &Sum::laps_completed)
       .def_readonly("lap_times_s", &Sum::lap_times_s)
       .def_readonly("limit_lap_s", &Sum::limit_lap_s)
+      .def_readonly("standing_limit_lap_s", &Sum::standing_limit_lap_s)
       .def_readonly("limit_lap_method", &Sum::limit_lap_method)
       .def_readonly("lap_time_ratio", &Sum::lap_time_ratio)
       .def_readonly("crashes", &Sum::crashes)

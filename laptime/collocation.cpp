@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <string>
 
 #include "base/error.hpp"
 #include "laptime/spatial_single_track.hpp"
@@ -16,8 +17,8 @@ constexpr int kNs = var::kStates;
 }  // namespace
 
 Collocation::Collocation(const SingleTrackParams& vehicle, std::vector<CollocationStation> stations,
-                         double command_smoothing_s)
-    : stations_(std::move(stations)), command_smoothing_s_(command_smoothing_s) {
+                         double command_smoothing_s, bool closed)
+    : stations_(std::move(stations)), command_smoothing_s_(command_smoothing_s), closed_(closed) {
   std::string why;
   if (!vehicle.is_valid(&why)) throw Error("min_time_lap: invalid vehicle parameters: " + why);
   if (stations_.size() < 8) throw Error("min_time_lap: needs at least 8 stations");
@@ -27,12 +28,21 @@ Collocation::Collocation(const SingleTrackParams& vehicle, std::vector<Collocati
 }
 
 int Collocation::variables() const { return stations() * kNz; }
-int Collocation::constraints() const { return stations() * kNs; }
+int Collocation::constraints() const { return intervals() * kNs; }
 int Collocation::jacobian_nonzeros() const { return constraints() * 2 * kNz; }
 
 double Collocation::station_weight_m(int i) const {
   const int n = stations();
-  return 0.5 * (stations_[static_cast<std::size_t>((i + n - 1) % n)].ds_m + stations_[static_cast<std::size_t>(i)].ds_m);
+  const bool has_previous = closed_ || i > 0, has_next = closed_ || i < n - 1;
+  return 0.5 * ((has_previous ? stations_[static_cast<std::size_t>((i + n - 1) % n)].ds_m : 0.0) +
+                (has_next ? stations_[static_cast<std::size_t>(i)].ds_m : 0.0));
+}
+
+void Collocation::fix(int station, int variable, double value) {
+  if (station < 0 || station >= stations() || variable < 0 || variable >= kNz)
+    throw Error("min_time_lap: cannot fix variable " + std::to_string(variable) + " of station " +
+                std::to_string(station) + " (" + std::to_string(stations()) + " stations)");
+  fixed_.emplace_back(station * kNz + variable, value);
 }
 
 void Collocation::bounds(double* lo, double* hi) const {
@@ -48,6 +58,7 @@ void Collocation::bounds(double* lo, double* hi) const {
     lo[i * kNz + var::kOffset] = stations_[static_cast<std::size_t>(i)].min_offset_m;
     hi[i * kNz + var::kOffset] = stations_[static_cast<std::size_t>(i)].max_offset_m;
   }
+  for (const auto& [index, value] : fixed_) lo[index] = hi[index] = value;
 }
 
 double Collocation::lap_time_s(const double* z) const {
@@ -60,7 +71,7 @@ double Collocation::lap_time_s(const double* z) const {
 double Collocation::objective(const double* z) const {
   double smooth = 0.0;
   const int n = stations();
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < intervals(); ++i) {
     const double* a = z + i * kNz;
     const double* b = z + ((i + 1) % n) * kNz;
     for (int v : {var::kSteer, var::kThrottle}) smooth += (b[v] - a[v]) * (b[v] - a[v]);
@@ -85,6 +96,7 @@ void Collocation::objective_gradient(const double* z, double* grad) const {
     gi[var::kHeadingError] += -w * a * (-vx * sx - vy * cx) / (d * d);
     gi[var::kVx] += -w * a * cx / (d * d);
     gi[var::kVy] += w * a * sx / (d * d);
+    if (i >= intervals()) continue;  // an open problem's last station has no next
     const double* zn = z + ((i + 1) % n) * kNz;
     double* gn = grad + ((i + 1) % n) * kNz;
     for (int v : {var::kSteer, var::kThrottle}) {
@@ -116,7 +128,7 @@ void Collocation::defects(const double* z, double* c) const {
   std::vector<double> g(static_cast<std::size_t>(n) * kNs);
   for (int i = 0; i < n; ++i)
     spatial_derivative(k_, z + i * kNz, stations_[static_cast<std::size_t>(i)].kappa_1pm, &g[static_cast<std::size_t>(i) * kNs]);
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < intervals(); ++i) {
     const int j = (i + 1) % n;
     const double half_ds = 0.5 * stations_[static_cast<std::size_t>(i)].ds_m;
     for (int r = 0; r < kNs; ++r)
@@ -129,7 +141,7 @@ void Collocation::defects(const double* z, double* c) const {
 void Collocation::jacobian_structure(int* rows, int* cols) const {
   const int n = stations();
   int k = 0;
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < intervals(); ++i) {
     const int j = (i + 1) % n;
     for (int r = 0; r < kNs; ++r) {
       for (int v = 0; v < kNz; ++v, ++k) {
@@ -150,7 +162,7 @@ void Collocation::jacobian_values(const double* z, double* values) const {
   for (int i = 0; i < n; ++i)
     derivative_and_jacobian(z + i * kNz, i, &g[static_cast<std::size_t>(i) * kNs], &dg[static_cast<std::size_t>(i) * kNs * kNz]);
   int k = 0;
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < intervals(); ++i) {
     const int j = (i + 1) % n;
     const double half_ds = 0.5 * stations_[static_cast<std::size_t>(i)].ds_m;
     const double* dgi = &dg[static_cast<std::size_t>(i) * kNs * kNz];

@@ -41,6 +41,13 @@ struct MinTimeLapOptions {
   // stop at its acceptable level (lap time settled to 1e-6 relative) when the defects are below it.
   double max_defect = 1e-3;
   bool verbose = false;             // IPOPT's iteration log on stdout
+  // Standing start (standing_start_lap): ds/dt = 0 at rest makes the spatial equations singular,
+  // so the first station is where the car, launched from rest at the start line at the car's
+  // maximal drive acceleration (launch_from_rest), reaches this speed [m/s]; the launch's time is
+  // added in closed form. The stations after it grow geometrically by this ratio until they reach
+  // station_spacing_m, so that the trapezoid in 1 / speed stays accurate while the speed climbs.
+  double launch_speed_mps = 1.0;
+  double launch_station_ratio = 1.2;
 };
 
 struct MinTimeLap {
@@ -57,10 +64,41 @@ struct MinTimeLap {
   double max_body_slip_rad = 0.0;
 };
 
+// The run from rest to a speed at the car's maximal drive acceleration on a straight: the driven
+// axle at its tyre's peak friction mu_R (sim::tyre_peak_friction) under the model's quasi-static
+// pitch transfer, for rear-wheel drive G = mu_R m g l_f / (L - h mu_R) (dynamics/single_track.hpp
+// with the front wheel rolling; a car with front drive gets sim::car_limits' static grip), less
+// rolling resistance and drag: m dv/dt = G - c v^2 with c = aero_drag_kgpm, in closed form
+//   t = m / sqrt(G c) atanh(v sqrt(c / G)),   x = m / (2 c) ln(G / (G - c v^2))
+// (t = m v / G, x = m v^2 / (2 G) without drag).
+struct Launch {
+  double time_s = 0.0;
+  double distance_m = 0.0;
+};
+// Throws mppi::Error where the launch is not grip-limited up to that speed (the motor's line
+// below the grip: the closed form does not hold) or the grip does not beat the resistances.
+Launch launch_from_rest(const SingleTrackParams& vehicle, double speed_mps);
+
+
 // Throws mppi::Error for bad options or parameters (naming them), a track too narrow for the
 // margin, or a solver that fails to start. A solve that stops short of the tolerance is returned
 // with converged = false and its status (the caller decides whether to trust it).
 MinTimeLap min_time_lap(const sim::Track& track, const SingleTrackParams& vehicle,
                         const MinTimeLapOptions& options = {});
+
+// The minimum-time lap from a standing start: the car at rest at the track's start pose (centreline
+// vertex 0, facing along the track: where the closed loop spawns it) once round to the start line
+// (where the closed loop counts the lap), the end state free. The same collocation, open: the first
+// station, options.launch_speed_mps past rest (at the launch's distance from the line), is fixed at
+// the start pose's offset and heading, that speed straight ahead, no yaw rate and rolling wheels;
+// the last station is the start line. lap.lap_time_s includes the launch (lap.launch_time_s).
+// The result's per-station vectors have one entry per station of the open problem, the last on the
+// start line. IPOPT starts from `flying` where given (min_time_lap's solution with the same
+// options: the standing lap is the flying one but for its first metres), slowed to the QSS lap
+// from rest where that is slower; else from the QSS lap from rest on the racing line. Throws as
+// min_time_lap, for a launch speed below 0.5 m/s or one whose launch does not fit before the
+// second station, and for a flying lap on other stations.
+MinTimeLap standing_start_lap(const sim::Track& track, const SingleTrackParams& vehicle,
+                              const MinTimeLapOptions& options = {}, const MinTimeLap* flying = nullptr);
 
 }  // namespace mppi::laptime

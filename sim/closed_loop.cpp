@@ -163,38 +163,56 @@ std::optional<SingleTrackParams> limit_lap_vehicle(const P& plant) {
   else return std::nullopt;
 }
 
-// The limit lap's time of a vehicle on the track; NaN where it cannot be computed (said on
-// stderr with progress on). Computed once per track, direction and vehicle in a process (a test
-// suite runs many loops).
-double vehicle_limit_lap_s(const ClosedLoopConfig& config, const SingleTrackParams& vehicle, const Track& track) {
+// The limit laps a run's laps are measured against: the first lap starts from rest at the start
+// line (the car is spawned there standing), the others are flying.
+struct LimitLapTimes {
+  double flying_s = std::numeric_limits<double>::quiet_NaN();
+  double standing_s = std::numeric_limits<double>::quiet_NaN();
+  // The reference of lap `lap` (1-based).
+  double for_lap(int lap) const { return lap == 1 ? standing_s : flying_s; }
+  bool any() const { return std::isfinite(flying_s) || std::isfinite(standing_s); }
+};
+
+// The limit lap's time of a vehicle on the track from the given start; NaN where it cannot be
+// computed (said on stderr with progress on). Computed once per track, direction, vehicle and
+// start in a process (a test suite runs many loops).
+double vehicle_limit_lap_s(const ClosedLoopConfig& config, const SingleTrackParams& vehicle, const Track& track,
+                           LapStart start) {
   static std::mutex mutex;
   static std::map<std::string, LimitLap> cache;
-  const std::string key = config.limit_lap_method + " " + track.name() +
+  const bool standing = start == LapStart::kStanding;
+  const char* what = standing ? "standing-start limit lap" : "limit lap";
+  const std::string key = config.limit_lap_method + (standing ? " standing " : " flying ") + track.name() +
                           (track.direction() == Direction::kClockwise ? " cw\n" : " ccw\n") + to_yaml(vehicle);
   try {
     std::unique_lock lock(mutex);
     auto it = cache.find(key);
-    if (it == cache.end()) it = cache.emplace(key, limit_lap_by_method(config.limit_lap_method, track, vehicle)).first;
+    if (it == cache.end())
+      it = cache.emplace(key, limit_lap_by_method(config.limit_lap_method, track, vehicle, start)).first;
     const LimitLap& lap = it->second;
     if (config.progress)
-      std::fprintf(stderr, "limit lap of the plant's vehicle (%s): %.2f s (mean %.2f m/s, max %.2f m/s; docs/LIMIT_LAP.md)\n",
-                   config.limit_lap_method.c_str(), lap.lap_time_s, lap.mean_speed_mps, lap.max_speed_mps);
+      std::fprintf(stderr, "%s of the plant's vehicle (%s): %.2f s (mean %.2f m/s, max %.2f m/s; docs/LIMIT_LAP.md)\n",
+                   what, config.limit_lap_method.c_str(), lap.lap_time_s, lap.mean_speed_mps, lap.max_speed_mps);
     return lap.lap_time_s;
   } catch (const Error& e) {
-    if (config.progress) std::fprintf(stderr, "no limit lap: %s\n", e.what());
+    if (config.progress) std::fprintf(stderr, "no %s: %s\n", what, e.what());
     return std::numeric_limits<double>::quiet_NaN();
   }
 }
 
 // The same for the plant's vehicle (limit_lap_vehicle; a corrected-model plant's from its file,
-// corrected_limit_lap_vehicle); NaN where the plant has none.
+// corrected_limit_lap_vehicle), flying and standing; NaN where the plant has none.
 template <class P>
-double plant_limit_lap_s(const ClosedLoopConfig& config, const P& plant, const Track& track) {
+LimitLapTimes plant_limit_laps(const ClosedLoopConfig& config, const P& plant, const Track& track) {
   const std::optional<SingleTrackParams> vehicle =
       config.plant == kCorrectedModel
           ? corrected_limit_lap_vehicle(load_corrected_model(config.plant_params_yaml))
           : limit_lap_vehicle(plant);
-  return vehicle ? vehicle_limit_lap_s(config, *vehicle, track) : std::numeric_limits<double>::quiet_NaN();
+  LimitLapTimes times;
+  if (!vehicle) return times;
+  times.flying_s = vehicle_limit_lap_s(config, *vehicle, track, LapStart::kFlying);
+  times.standing_s = vehicle_limit_lap_s(config, *vehicle, track, LapStart::kStanding);
+  return times;
 }
 
 std::string format_times(const std::vector<double>& times) {
@@ -212,7 +230,7 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
                           const AutoRallyCost& cost) {
   ControllerSetup setup = make_controller(config, cost);
   Controller* controller = setup.controller.get();
-  const double limit_lap_s = plant_limit_lap_s(config, plant_model, track);
+  const LimitLapTimes limit_laps = plant_limit_laps(config, plant_model, track);
   Plant<P> plant(std::move(plant_model), config.actuators, static_cast<float>(config.plant_dt_s));
   const Pose2 start = track.start_pose();
   VehicleState s0;
@@ -259,8 +277,9 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   summary.horizon = config.controller.horizon;
   summary.target_speed_mps = config.target_speed_mps;
   summary.backend = setup.backend;
-  summary.limit_lap_s = limit_lap_s;
-  if (std::isfinite(limit_lap_s)) summary.limit_lap_method = config.limit_lap_method;
+  summary.limit_lap_s = limit_laps.flying_s;
+  summary.standing_limit_lap_s = limit_laps.standing_s;
+  if (limit_laps.any()) summary.limit_lap_method = config.limit_lap_method;
   long control_step = 0;
 
   std::vector<float> model_x(static_cast<std::size_t>(setup.model_states));
@@ -415,9 +434,11 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
     if (laps.laps_completed() > reported_laps && config.progress) {
       reported_laps = laps.laps_completed();
       const double lap_time = laps.lap_times_s().back();
-      char ratio[80] = "";
-      if (std::isfinite(limit_lap_s))
-        std::snprintf(ratio, sizeof ratio, "%.2f x the limit lap %.2f s; ", lap_time / limit_lap_s, limit_lap_s);
+      char ratio[96] = "";
+      const double limit_s = limit_laps.for_lap(reported_laps);
+      if (std::isfinite(limit_s))
+        std::snprintf(ratio, sizeof ratio, "%.2f x the %slimit lap %.2f s; ", lap_time / limit_s,
+                      reported_laps == 1 ? "standing-start " : "", limit_s);
       std::fprintf(stderr, "lap %d/%d: %.2f s (%smean %.2f m/s), crashes so far %d, t = %.1f s\n",
                    reported_laps, config.laps, lap_time, ratio, track.length_m() / lap_time,
                    summary.crashes, t);
@@ -427,8 +448,10 @@ RunSummary run_with_plant(const ClosedLoopConfig& config, P plant_model, const T
   summary.sim_time_s = t;
   summary.laps_completed = laps.laps_completed();
   summary.lap_times_s = laps.lap_times_s();
-  if (std::isfinite(limit_lap_s))
-    for (double lap_time : summary.lap_times_s) summary.lap_time_ratio.push_back(lap_time / limit_lap_s);
+  // Lap 1 against the standing-start limit lap (the car starts it from rest), the others the flying one.
+  if (limit_laps.any())
+    for (std::size_t i = 0; i < summary.lap_times_s.size(); ++i)
+      summary.lap_time_ratio.push_back(summary.lap_times_s[i] / limit_laps.for_lap(static_cast<int>(i) + 1));
   summary.finished = summary.laps_completed >= config.laps;
   summary.mean_speed_mps = speed_samples ? speed_sum / speed_samples : 0.0;
   summary.mean_abs_steer_step = command_steps.mean_abs_steer_step();

@@ -79,7 +79,9 @@ struct ClosedLoopConfig {
 
 // Runs the loop; throws mppi::Error for bad settings or data files. For a plant with
 // single-track parameters (plant_vehicle_params) each lap is also given as a ratio to that
-// vehicle's limit lap on the track (sim/limit_lap.hpp; RunSummary::limit_lap_s, lap_time_ratio).
+// vehicle's limit lap on the track (sim/limit_lap.hpp; RunSummary::limit_lap_s, lap_time_ratio):
+// lap 1, which the car starts from rest at the start line, to the standing-start limit lap
+// (RunSummary::standing_limit_lap_s), the others to the flying one.
 RunSummary run_closed_loop(const ClosedLoopConfig& config);
 
 // The single-track parameters of the config's plant, whose limit lap its laps are measured

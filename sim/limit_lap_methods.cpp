@@ -9,10 +9,22 @@
 namespace mppi::sim {
 namespace {
 
+// Both QSS laps from one set of racing lines, kept per track (by name and direction) and vehicle:
+// a closed-loop run asks for the flying lap, then the standing start.
+LimitLap qss_limit_lap(const Track& track, const SingleTrackParams& vehicle, LapStart start) {
+  static std::mutex mutex;
+  static std::map<std::string, QssLimitLaps> cache;
+  const std::string key = track.name() + (track.direction() == Direction::kClockwise ? " cw\n" : " ccw\n") +
+                          to_yaml(vehicle);
+  std::lock_guard lock(mutex);
+  auto it = cache.find(key);
+  if (it == cache.end()) it = cache.emplace(key, flying_and_standing_limit_laps(track, vehicle)).first;
+  return start == LapStart::kStanding ? it->second.standing : it->second.flying;
+}
+
 struct Registry {
   std::mutex mutex;
-  std::map<std::string, LimitLapMethod> methods{
-      {"qss", [](const Track& track, const SingleTrackParams& vehicle) { return limit_lap(track, vehicle); }}};
+  std::map<std::string, LimitLapMethod> methods{{"qss", qss_limit_lap}};
 };
 
 Registry& registry() {
@@ -46,7 +58,8 @@ void require_limit_lap_method(const std::string& name) {
               "; 'collocation' needs the build with IPOPT, coinor-libipopt-dev)");
 }
 
-LimitLap limit_lap_by_method(const std::string& name, const Track& track, const SingleTrackParams& vehicle) {
+LimitLap limit_lap_by_method(const std::string& name, const Track& track, const SingleTrackParams& vehicle,
+                             LapStart start) {
   LimitLapMethod method;
   {
     Registry& r = registry();
@@ -55,7 +68,7 @@ LimitLap limit_lap_by_method(const std::string& name, const Track& track, const 
     if (it != r.methods.end()) method = it->second;
   }
   if (!method) require_limit_lap_method(name);  // throws, naming the known methods
-  return method(track, vehicle);
+  return method(track, vehicle, start);
 }
 
 }  // namespace mppi::sim

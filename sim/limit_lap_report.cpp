@@ -43,7 +43,15 @@ std::string describe_limit_lap(const LimitLap& lap) {
   return text;
 }
 
-LimitLap report_limit_lap(const ClosedLoopConfig& config) {
+std::string describe_limit_laps(const LimitLaps& laps) {
+  if (!laps.standing) return describe_limit_lap(laps.flying) + "standing-start lap  none: " + laps.standing_error + "\n";
+  char text[256];
+  std::snprintf(text, sizeof text, "standing-start lap  %.2f s (from rest at the start line; mean %.2f m/s, max %.2f m/s)\n",
+                laps.standing->lap_time_s, laps.standing->mean_speed_mps, laps.standing->max_speed_mps);
+  return describe_limit_lap(laps.flying) + text;
+}
+
+LimitLaps report_limit_lap(const ClosedLoopConfig& config) {
   const std::optional<SingleTrackParams> vehicle = plant_vehicle_params(config);
   if (!vehicle)
     throw Error("the plant '" + config.plant + "' has no single-track parameters, so no limit lap (single-track, "
@@ -51,16 +59,24 @@ LimitLap report_limit_lap(const ClosedLoopConfig& config) {
   TrackOptions track_options;
   track_options.direction = config.clockwise ? Direction::kClockwise : Direction::kCounterClockwise;
   const Track track = Track::load(config.track, track_options);
-  const LimitLap lap = limit_lap_by_method(config.limit_lap_method, track, *vehicle);
+  LimitLaps laps;
+  laps.flying = limit_lap_by_method(config.limit_lap_method, track, *vehicle, LapStart::kFlying);
+  try {
+    laps.standing = limit_lap_by_method(config.limit_lap_method, track, *vehicle, LapStart::kStanding);
+  } catch (const Error& e) {
+    laps.standing_error = e.what();
+  }
+  const LimitLap& lap = laps.flying;
   if (!config.out_dir.empty()) {
     std::filesystem::create_directories(config.out_dir);
     write_limit_lap_csv(config.out_dir + "/limit_lap.csv", lap);
+    if (laps.standing) write_limit_lap_csv(config.out_dir + "/standing_limit_lap.csv", *laps.standing);
     char title[256];
     std::snprintf(title, sizeof title, "%s | limit lap (%s) of the %s plant: %.2f s, mean %.2f m/s", track.name().c_str(),
                   config.limit_lap_method.c_str(), config.plant.c_str(), lap.lap_time_s, lap.mean_speed_mps);
     plot_limit_lap(config.out_dir + "/limit_lap.png", track, lap, title);
   }
-  return lap;
+  return laps;
 }
 
 }  // namespace mppi::sim

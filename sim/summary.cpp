@@ -32,6 +32,7 @@ std::string to_json(const RunSummary& s) {
   j["lap_times_s"] = nlohmann::ordered_json::array();
   for (double t : s.lap_times_s) j["lap_times_s"].push_back(number(t));
   j["limit_lap_s"] = number(s.limit_lap_s);
+  j["standing_limit_lap_s"] = number(s.standing_limit_lap_s);
   j["limit_lap_method"] = s.limit_lap_method.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(s.limit_lap_method);
   j["lap_time_ratio"] = nlohmann::ordered_json::array();
   for (double r : s.lap_time_ratio) j["lap_time_ratio"].push_back(number(r));

@@ -27,9 +27,12 @@ struct RunSummary {
   bool finished = false;              // reached the requested laps / time without stopping early
   int laps_completed = 0;
   std::vector<double> lap_times_s;
-  // The limit lap of the plant's vehicle file on this track (sim/limit_lap.hpp) and each lap's
-  // time over it; NaN and empty for plants without single-track parameters.
+  // The limit lap of the plant's vehicle file on this track (sim/limit_lap.hpp): the flying lap and
+  // the lap from a standing start at the start line (where the car is spawned at rest); each lap's
+  // time over its reference: lap 1 over the standing-start lap, the others over the flying one.
+  // NaN and empty for plants without single-track parameters (a NaN ratio where one is missing).
   double limit_lap_s = std::numeric_limits<double>::quiet_NaN();
+  double standing_limit_lap_s = std::numeric_limits<double>::quiet_NaN();
   std::string limit_lap_method;  // sim/limit_lap_methods.hpp; empty where there is no limit lap
   std::vector<double> lap_time_ratio;
   int crashes = 0;

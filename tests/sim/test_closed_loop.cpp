@@ -35,6 +35,12 @@ TEST_CASE("single-track MPPI laps the Gazebo oval without crashing", "[sim][clos
   CHECK(summary.lap_times_s[0] > 10.0);
   CHECK(summary.lap_times_s[0] < 21.0);
   CHECK(summary.max_speed_mps < 5.0 * 1.4);
+  // Lap 1 starts from rest at the start line: it is measured against the standing-start limit lap,
+  // which is slower than the flying one and no faster than the lap itself.
+  REQUIRE(summary.lap_time_ratio.size() == 1);
+  CHECK(summary.standing_limit_lap_s > summary.limit_lap_s);
+  CHECK(summary.lap_time_ratio[0] == Approx(summary.lap_times_s[0] / summary.standing_limit_lap_s).epsilon(1e-12));
+  CHECK(summary.lap_time_ratio[0] >= 1.0);
 }
 
 TEST_CASE("the AutoRally network drives the physics plant around the oval", "[sim][closed_loop]") {

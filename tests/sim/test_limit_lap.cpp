@@ -147,6 +147,93 @@ TEST_CASE("qss: the forward pass on the drive line matches an integration of m d
   CHECK(p.speed_mps.back() > 10.0);  // the drive line, not the start, sets these speeds
 }
 
+TEST_CASE("qss: a standing start loses what an integration from rest of the drive line says", "[limit_lap]") {
+  // The calibrated car's drive line and rear-axle grip, from its file, written here: on a circle of
+  // 100 m with the friction made large, the lateral acceleration takes nothing from the drive.
+  const mppi::SingleTrackParams p = default_plant();
+  CarLimits car;
+  car.mass_kg = p.mass_kg;
+  car.gravity_mps2 = p.gravity_mps2;
+  car.mu = 50.0;
+  car.drive_force_N = p.stall_torque_Nm / p.wheel_radius_m;
+  car.no_load_speed_mps = p.no_load_speed_mps;
+  car.traction_grip_N = (p.tyre.D + p.tyre.Sv) * p.mass_kg * p.gravity_mps2 * p.cg_to_front_axle_m / p.wheelbase_m();
+  car.brake_force_N = car.drive_force_N;
+  car.drag_kgpm = p.aero_drag_kgpm;
+  car.rolling_force_N = p.rolling_resistance * p.mass_kg * p.gravity_mps2;
+  Polyline circle;
+  const int vertices = 1257;  // 0.5 m apart
+  for (int i = 0; i < vertices; ++i)
+    circle.push_back({100.0 * std::cos(2 * kPi * i / vertices), 100.0 * std::sin(2 * kPi * i / vertices)});
+  const LimitLap flying = lap_on_line(circle, car);
+  const LimitLap standing = standing_lap_on_line(circle, car);
+  REQUIRE(standing.standing_start);
+  REQUIRE(standing.speed_mps.size() == circle.size() + 1);
+  CHECK(standing.speed_mps.front() == 0.0);
+  CHECK(standing.length_m == Approx(flying.length_m).epsilon(1e-12));
+  // Independent: RK4 in time of m dv/dt = min(F(v), grip) - c v^2 - rolling from rest until the
+  // lap's length is covered; the flying lap at the speed where the drive meets the resistances.
+  auto dv = [&](double v) {
+    const double drive = std::min(car.drive_force_N * (1 - v / car.no_load_speed_mps), car.traction_grip_N);
+    return (drive - car.drag_kgpm * v * v - car.rolling_force_N) / car.mass_kg;
+  };
+  double x = 0, v = 0, t = 0;
+  const double dt = 1e-4;
+  while (x < flying.length_m) {
+    const double k1v = dv(v), k1x = v;
+    const double k2v = dv(v + 0.5 * dt * k1v), k2x = v + 0.5 * dt * k1v;
+    const double k3v = dv(v + 0.5 * dt * k2v), k3x = v + 0.5 * dt * k2v;
+    const double k4v = dv(v + dt * k3v), k4x = v + dt * k3v;
+    x += dt / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
+    v += dt / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+    t += dt;
+  }
+  double lo = 0, hi = car.no_load_speed_mps;
+  for (int i = 0; i < 100; ++i) (dv(0.5 * (lo + hi)) > 0 ? lo : hi) = 0.5 * (lo + hi);
+  const double flying_oracle_s = flying.length_m / lo;
+  const double lost_oracle_s = t - flying_oracle_s;
+  INFO("standing " << standing.lap_time_s << " s (oracle " << t << "), flying " << flying.lap_time_s << " s (oracle "
+                   << flying_oracle_s << "), time lost " << standing.lap_time_s - flying.lap_time_s << " s (oracle "
+                   << lost_oracle_s << ")");
+  CHECK(lost_oracle_s > 2.0);  // the start matters here
+  CHECK(flying.lap_time_s == Approx(flying_oracle_s).epsilon(1e-4));
+  CHECK(standing.lap_time_s == Approx(t).epsilon(1e-3));
+  CHECK(standing.lap_time_s - flying.lap_time_s == Approx(lost_oracle_s).epsilon(1e-2));
+}
+
+TEST_CASE("qss: the standing-start limit lap is slower than the flying one and joins it", "[limit_lap]") {
+  const Track& oval = track_named("gazebo");
+  const mppi::SingleTrackParams car = default_plant();
+  const LimitLap flying = limit_lap(oval, car);
+  const LimitLap standing = standing_limit_lap(oval, car);
+  INFO("flying " << flying.lap_time_s << " s, standing " << standing.lap_time_s << " s");
+  CHECK(standing.standing_start);
+  CHECK_FALSE(flying.standing_start);
+  CHECK(standing.speed_mps.front() == 0.0);
+  // On one line (the standing lap's), the standing profile never exceeds the flying one.
+  RacingLineOptions line_options;
+  line_options.margin_m = 0.5;
+  line_options.length_weight_1pm2 = standing.length_weight_1pm2;
+  const Polyline line = racing_line(oval, line_options).line;
+  const LimitLap on_line_flying = lap_on_line(line, car_limits(car));
+  const LimitLap on_line_standing = standing_lap_on_line(line, car_limits(car));
+  CHECK(on_line_standing.lap_time_s == Approx(standing.lap_time_s).epsilon(1e-12));
+  for (std::size_t i = 0; i < line.size(); ++i) REQUIRE(on_line_standing.speed_mps[i] <= on_line_flying.speed_mps[i] + 1e-12);
+  // The time lost is at least what the best launch loses against the flying lap's slowest speed
+  // v_m over the first v_line^2 / (2 a) metres: from rest at most sqrt(2 a x) with a the drive's
+  // grip over the mass, so the loss is >= the integral of 1 / sqrt(2 a x) - 1 / v_m up to
+  // v_m^2 / (2 a): v_m / a - v_m / (2 a) = v_m / (2 a). (The flying lap on the best line is no slower.)
+  const double a_max = car_limits(car).traction_grip_N / car.mass_kg;
+  const double reach_m = on_line_flying.speed_mps.front() * on_line_flying.speed_mps.front() / (2 * a_max);
+  double v_m = on_line_flying.speed_mps.front();
+  for (std::size_t i = 0; i < line.size() && on_line_flying.s_m[i] <= reach_m + 1.0; ++i)
+    v_m = std::min(v_m, on_line_flying.speed_mps[i]);
+  INFO("least loss " << v_m / (2 * a_max) << " s");
+  CHECK(standing.lap_time_s - flying.lap_time_s >= v_m / (2 * a_max));
+  // It catches the flying profile before the line again and ends at its speed there.
+  CHECK(on_line_standing.speed_mps.back() == Approx(on_line_flying.speed_mps.front()).epsilon(1e-9));
+}
+
 TEST_CASE("qss: braking from v0 to rest takes v0^2 / (2 a_brake)", "[limit_lap]") {
   CarLimits car = plain_car();
   car.closed = false;

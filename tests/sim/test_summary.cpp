@@ -47,8 +47,9 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.laps_completed = 2;
   s.lap_times_s = {12.5, 11.75};
   s.limit_lap_s = 6.25;
+  s.standing_limit_lap_s = 7.8125;
   s.limit_lap_method = "collocation";
-  s.lap_time_ratio = {2.0, 1.88};
+  s.lap_time_ratio = {1.6, 1.88};  // lap 1 over the standing-start limit lap
   s.crashes = 1;
   s.crash_reasons = {"hit the outer barrier at (1.00, 2.00)"};
   s.stalls = 1;
@@ -73,7 +74,7 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   s.lateral_force_scale_final = 0.625;
   s.lateral_force_scale_p50 = 0.75;
   const auto j = nlohmann::json::parse(to_json(s));
-  CHECK(j.size() == 41);
+  CHECK(j.size() == 42);
   CHECK(j.at("lateral_force_adaptation") == true);
   CHECK(j.at("lateral_force_scale_final") == 0.625);
   CHECK(j.at("lateral_force_scale_p50") == 0.75);
@@ -98,7 +99,9 @@ TEST_CASE("run summary JSON has every field, NaN as null", "[sim]") {
   CHECK(j.at("laps_completed") == 2);
   CHECK(j.at("lap_times_s") == nlohmann::json::array({12.5, 11.75}));
   CHECK(j.at("limit_lap_s") == 6.25);
-  CHECK(j.at("lap_time_ratio") == nlohmann::json::array({2.0, 1.88}));
+  CHECK(j.at("standing_limit_lap_s") == 7.8125);
+  CHECK(nlohmann::json::parse(to_json(RunSummary{})).at("standing_limit_lap_s").is_null());
+  CHECK(j.at("lap_time_ratio") == nlohmann::json::array({1.6, 1.88}));
   CHECK(j.at("crashes") == 1);
   CHECK(j.at("crash_reasons")[0] == "hit the outer barrier at (1.00, 2.00)");
   CHECK(j.at("stalls") == 1);

@@ -20,6 +20,7 @@ def run_figures(summary):
         'lap_times_s': laps,
         'mean_lap_s': sum(laps) / len(laps) if laps else float('nan'),
         'limit_lap_s': limit if limit is not None else float('nan'),
+        # each lap over its limit lap: lap 1 (from rest) over standing_limit_lap_s, the others limit_lap_s
         'mean_lap_over_limit': sum(ratios) / len(ratios) if ratios else float('nan'),
         'mean_speed_mps': summary.get('mean_speed_mps'),
         'max_speed_mps': summary.get('max_speed_mps'),
