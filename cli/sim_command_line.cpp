@@ -163,7 +163,15 @@ void add_sim_options(CLI::App& app, SimCommandLine& cl) {
                    "robust with --robust-augmented: the most a sample's real-system rollout may cost (RMPPI's "
                    "bound; default inf: unbounded) [cost units]")
       ->type_name("C")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {  // > 0, inf included (what --dump-config writes)
+            try {
+              return std::stod(text) > 0 ? "" : "must be > 0 (inf: unbounded), got " + text;
+            } catch (const std::exception&) {
+              return "must be a number > 0 or inf, got " + text;
+            }
+          },
+          "POSITIVE or inf"));
   add_float_list_option(app, "--ancillary-q", mppi.ancillary.q_diag,
                         "tube / robust: the feedback's state weights, comma-separated, one per model state "
                         "(empty: 1 each)")
