@@ -154,8 +154,7 @@ int cmd_diagnose(DiagnoseArgs& args) {
               r.headline_after, 100 * r.heldout_rmse_reduction);
   if (test)
     std::printf("test (%s; never seen by the fit or the validation): %.4f -> %.4f (%.1f %% reduction)%s\n",
-                test_name.c_str(), r.test_headline_before, r.test_headline_after,
-                100 * (r.test_headline_before > 0 ? 1.0 - r.test_headline_after / r.test_headline_before : 0.0),
+                test_name.c_str(), r.test.headline_nominal, r.test.headline_corrected, 100 * r.test.reduction,
                 r.selection.reliable ? "" : "; not written");
   std::printf("report: %s/report.md\n", o.out_dir.c_str());
   return 0;

@@ -14,6 +14,7 @@
 #include "cli/options.hpp"
 #include "diagnose/data.hpp"
 #include "diagnose/evaluate.hpp"
+#include "diagnose/model_comparison.hpp"
 #include "dynamics/corrected_model.hpp"
 #include "mppi_fit_commands.hpp"
 
@@ -26,19 +27,6 @@ struct EvaluateArgs {
   std::string model_file, log, out;
   EvaluateOptions o;
 };
-
-nlohmann::json metrics_json(const std::vector<HorizonMetrics>& ms) {
-  nlohmann::json a = nlohmann::json::array();
-  for (const auto& m : ms)
-    a.push_back({{"horizon_s", m.horizon_s},
-                 {"starts", m.starts},
-                 {"rmse_vx", m.rmse[0]},
-                 {"rmse_vy", m.rmse[1]},
-                 {"rmse_yaw_rate", m.rmse[2]},
-                 {"position_rmse_m", m.position_rmse_m},
-                 {"normalized_rmse", m.normalized_rmse}});
-  return a;
-}
 
 int run_evaluate(EvaluateArgs& args) {
   try {
@@ -68,8 +56,8 @@ int run_evaluate(EvaluateArgs& args) {
                                 {"headline_horizon_s", o.headline_horizon_s},
                                 {"headline", {{"nominal", r.headline_nominal}, {"corrected", r.headline_corrected},
                                               {"reduction", r.reduction}}},
-                                {"nominal", metrics_json(r.nominal)},
-                                {"corrected", metrics_json(r.corrected)}};
+                                {"nominal", horizon_metrics_json(r.nominal)},
+                                {"corrected", horizon_metrics_json(r.corrected)}};
       const std::filesystem::path parent = std::filesystem::path(args.out).parent_path();
       if (!parent.empty()) std::filesystem::create_directories(parent);
       std::ofstream f(args.out);

@@ -1,5 +1,6 @@
 #include "diagnose/diagnose.hpp"
 #include "diagnose/evaluate.hpp"
+#include "diagnose/model_comparison.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -38,29 +39,6 @@ json screening_json(const DiagData& d) {
                      {"value", value}, {"kind", f.kind}});
   }
   return {{"flagged", d.flags.size()}, {"rows_dropped", d.screened_rows}, {"flags", flags}};
-}
-
-json metrics_json(const std::vector<HorizonMetrics>& ms) {
-  json out = json::array();
-  for (const auto& m : ms) {
-    json j;
-    j["horizon_s"] = m.horizon_s;
-    j["starts"] = m.starts;
-    for (int c = 0; c < kChannels; ++c) {
-      j["rmse"][kChannelNames[c]] = num(m.rmse[c]);
-      j["fit_percent"][kChannelNames[c]] = num(m.fit_percent[c]);
-    }
-    j["position_rmse_m"] = num(m.position_rmse_m);
-    j["normalized_rmse"] = num(m.normalized_rmse);
-    out.push_back(j);
-  }
-  return out;
-}
-
-const HorizonMetrics* at_horizon(const std::vector<HorizonMetrics>& ms, double h) {
-  for (const auto& m : ms)
-    if (std::abs(m.horizon_s - h) < 1e-9) return &m;
-  return nullptr;
 }
 
 }  // namespace
@@ -128,17 +106,9 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
     if (!b.empty() && !a.empty()) res.per_recording.push_back({part.name, b[0].normalized_rmse, a[0].normalized_rmse});
   }
   // The test part: data the selection never saw, scored whatever the veto decided.
-  if (o.test) {
-    const std::vector<char> all(o.test->rows(), 1);
-    res.test_before = horizon_metrics(nominal_model, *o.test, all, hs, 5, o.replay);
-    res.test_after = horizon_metrics(corrected, *o.test, all, hs, 5, o.replay);
-    const HorizonMetrics* tb = at_horizon(res.test_before, o.headline_horizon_s);
-    const HorizonMetrics* ta = at_horizon(res.test_after, o.headline_horizon_s);
-    if (tb && ta) {
-      res.test_headline_before = tb->normalized_rmse;
-      res.test_headline_after = ta->normalized_rmse;
-    }
-  }
+  if (o.test)
+    res.test = compare_models(nominal_model, corrected, *o.test, std::vector<char>(o.test->rows(), 1), o.horizons_s,
+                              o.headline_horizon_s, o.replay);
   // What is left: the corrected model's residuals, located on the held-out part.
   const ResidualSeries rs_after = residual_series(corrected, d, o.locate_horizon_s, o.replay);
   res.remaining = locate(d, rs_after, held);
@@ -252,20 +222,18 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
     parts.push_back({{"recording", p.name}, {"normalized_rmse_before", num(p.before)}, {"normalized_rmse_after", num(p.after)},
                      {"reduction", num(p.before > 0 ? 1.0 - p.after / p.before : 0.0)}});
   j["per_recording"] = parts;
-  if (o.test) {
-    const double before = res.test_headline_before, after = res.test_headline_after;
+  if (o.test)
     j["test"] = {{"data", o.test_name.empty() ? o.test->source : o.test_name},
                  {"rows", o.test->rows()},
                  {"horizon_s", o.headline_horizon_s},
-                 {"normalized_rmse_before", num(before)},
-                 {"normalized_rmse_after", num(after)},
-                 {"reduction", num(before > 0 ? 1.0 - after / before : 0.0)},
+                 {"normalized_rmse_before", num(res.test.headline_nominal)},
+                 {"normalized_rmse_after", num(res.test.headline_corrected)},
+                 {"reduction", num(res.test.reduction)},
                  {"correction_written", res.selection.reliable},
-                 {"metrics_before", metrics_json(res.test_before)},
-                 {"metrics_after", metrics_json(res.test_after)}};
-  }
-  j["metrics_before"] = metrics_json(res.before);
-  j["metrics_after"] = metrics_json(res.after);
+                 {"metrics_before", horizon_metrics_json(res.test.nominal)},
+                 {"metrics_after", horizon_metrics_json(res.test.corrected)}};
+  j["metrics_before"] = horizon_metrics_json(res.before);
+  j["metrics_after"] = horizon_metrics_json(res.after);
   j["selection_log"] = res.selection.log;
   j["model_file"] = res.model_file;
   // The report's figures: the same data in report.json, the PNGs and report.html.
@@ -365,10 +333,10 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
             if (!o.test) return std::string();
             std::ostringstream t;
             t.precision(4);
-            const double b = res.test_headline_before, a = res.test_headline_after;
             t << "**Test** (" << (o.test_name.empty() ? o.test->source : o.test_name)
               << ", data that neither the fit nor the validation saw): normalised RMSE at " << o.headline_horizon_s
-              << " s " << b << " -> " << a << " (" << 100 * (b > 0 ? 1.0 - a / b : 0.0) << " % reduction)"
+              << " s " << res.test.headline_nominal << " -> " << res.test.headline_corrected << " ("
+              << 100 * res.test.reduction << " % reduction)"
               << (res.selection.reliable ? "" : "; this correction was not written (no reliable correction)") << ".\n\n";
             return t.str();
           }()

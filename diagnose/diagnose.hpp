@@ -9,6 +9,7 @@
 #include "diagnose/data.hpp"
 #include "diagnose/fit.hpp"
 #include "diagnose/locate.hpp"
+#include "diagnose/model_comparison.hpp"
 #include "diagnose/model_family.hpp"
 #include "diagnose/replay.hpp"
 
@@ -60,10 +61,8 @@ struct DiagnoseResult {
     double before = 0, after = 0;
   };
   std::vector<PartScore> per_recording;
-  // On DiagnoseOptions::test (empty without one): one-step, then the horizons, of the nominal and
-  // of the selection's corrected model; the normalised RMSE at the headline horizon.
-  std::vector<HorizonMetrics> test_before, test_after;
-  double test_headline_before = 0, test_headline_after = 0;
+  // On DiagnoseOptions::test (empty without one): the nominal and the selection's corrected model.
+  ModelComparison test;
   std::string model_file;
   std::string json;                           // report.json text
 };

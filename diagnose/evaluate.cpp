@@ -1,6 +1,7 @@
 // mppi-fit evaluate: a written corrected model against its nominal model on a recording.
 #include "diagnose/evaluate.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -92,23 +93,12 @@ EvaluateResult evaluate_corrected_model(const CorrectedModelFile& model, const s
   check_model_matches_recording(model, model_source, d, o);
   std::vector<char> mask(d.rows(), 1);
   if (o.rows != "all") mask = make_split(d, o.rows).heldout;
-  EvaluateResult r;
-  for (char m : mask) r.rows_scored += m != 0;
-  if (r.rows_scored == 0) throw Error(d.source + ": no rows to score for --rows '" + o.rows + "'");
+  const auto rows_scored = static_cast<std::size_t>(std::count(mask.begin(), mask.end(), 1));
+  if (rows_scored == 0) throw Error(d.source + ": no rows to score for --rows '" + o.rows + "'");
   const auto family = model_family_of(model);
-  const auto nominal = family->make({});
-  const auto corrected = family->make(model.effects);
-  std::vector<double> hs = {d.dt_s};
-  hs.insert(hs.end(), o.horizons_s.begin(), o.horizons_s.end());
-  r.nominal = horizon_metrics(*nominal, d, mask, hs, 5, o.replay);
-  r.corrected = horizon_metrics(*corrected, d, mask, hs, 5, o.replay);
-  for (std::size_t i = 0; i < r.nominal.size() && i < r.corrected.size(); ++i)
-    if (std::abs(r.nominal[i].horizon_s - o.headline_horizon_s) < 1e-9) {
-      r.headline_nominal = r.nominal[i].normalized_rmse;
-      r.headline_corrected = r.corrected[i].normalized_rmse;
-      r.reduction = r.headline_nominal > 0 ? 1.0 - r.headline_corrected / r.headline_nominal : 0.0;
-    }
-  return r;
+  return {compare_models(*family->make({}), *family->make(model.effects), d, mask, o.horizons_s,
+                         o.headline_horizon_s, o.replay),
+          rows_scored};
 }
 
 }  // namespace mppi::diagnose

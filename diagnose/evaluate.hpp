@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "diagnose/data.hpp"
+#include "diagnose/model_comparison.hpp"
 #include "diagnose/replay.hpp"
 #include "dynamics/corrected_model.hpp"
 
@@ -25,10 +26,7 @@ struct EvaluateOptions {
   double geometry_tolerance = 0.1;
 };
 
-struct EvaluateResult {
-  std::vector<HorizonMetrics> nominal, corrected;  // one-step first, then the horizons
-  double headline_nominal = 0, headline_corrected = 0;  // normalised RMSE at the headline horizon
-  double reduction = 0;                                 // 1 - corrected / nominal at the headline
+struct EvaluateResult : ModelComparison {
   std::size_t rows_scored = 0;
 };
 

@@ -116,14 +116,14 @@ TEST_CASE("a diagnosis scores its correction on test data that neither its fit n
   o.test_name = "the last 30 %";
   const DiagnoseResult r = run_diagnosis(fit, *make_model_family("single-track"), o);
   REQUIRE(r.selection.selected == std::vector<std::string>{"steer_delay"});
-  INFO("test: " << r.test_headline_before << " -> " << r.test_headline_after);
-  CHECK(r.test_headline_after < 0.7 * r.test_headline_before);
+  INFO("test: " << r.test.headline_nominal << " -> " << r.test.headline_corrected);
+  CHECK(r.test.headline_corrected < 0.7 * r.test.headline_nominal);
   // The same figures from the corrected model, scored by evaluate on the test part alone.
   CorrectedModelFile f = make_model_family("single-track")->file(r.selection.final_effects, r.selection.selected);
   EvaluateOptions eo;
   const EvaluateResult e = evaluate_corrected_model(f, "corrected", test, eo);
-  CHECK(e.headline_nominal == Approx(r.test_headline_before).epsilon(1e-6));
-  CHECK(e.headline_corrected == Approx(r.test_headline_after).epsilon(1e-6));
+  CHECK(e.headline_nominal == Approx(r.test.headline_nominal).epsilon(1e-6));
+  CHECK(e.headline_corrected == Approx(r.test.headline_corrected).epsilon(1e-6));
   const auto j = nlohmann::json::parse(r.json);
   CHECK(j.at("test").at("data") == "the last 30 %");
   CHECK(j.at("test").at("rows") == test.rows());
