@@ -14,11 +14,14 @@ ResidualSeries residual_series(const ReplayModel& model, const DiagData& d, doub
   const int len = std::max(1, static_cast<int>(std::lround(horizon_s / d.dt_s)));
   rs.horizon_s = len * d.dt_s;
   for (auto& v : rs.e) v.assign(d.rows(), std::numeric_limits<double>::quiet_NaN());
-  std::vector<double> pred(static_cast<std::size_t>(len) * kPredStride);
-  for (std::size_t k = 0; k + static_cast<std::size_t>(len) < d.rows(); ++k) {
-    if (!d.continuous(k, static_cast<std::size_t>(len))) continue;
-    predict_segment(model, d, {k, len}, o, pred.data());
-    const double* p = pred.data() + static_cast<std::size_t>(len - 1) * kPredStride;
+  std::vector<Segment> segs;
+  for (std::size_t k = 0; k + static_cast<std::size_t>(len) < d.rows(); ++k)
+    if (d.continuous(k, static_cast<std::size_t>(len))) segs.push_back({k, len});
+  std::vector<double> pred(segs.size() * static_cast<std::size_t>(len) * kPredStride);
+  predict_segments(model, d, segs, o, pred.data());
+  for (std::size_t n = 0; n < segs.size(); ++n) {
+    const std::size_t k = segs[n].start;
+    const double* p = pred.data() + ((n + 1) * static_cast<std::size_t>(len) - 1) * kPredStride;
     const double h = d.t[k + static_cast<std::size_t>(len)] - d.t[k];
     for (int c = 0; c < kChannels; ++c)
       if (std::isfinite(p[c])) rs.e[c][k] = (d.channel(c, k + static_cast<std::size_t>(len)) - p[c]) / h;

@@ -3,6 +3,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "base/multiversion.hpp"
 #include "dynamics/with_effects.hpp"
 #include "dynamics/model_registry.hpp"
 #include "base/error.hpp"
@@ -11,10 +12,19 @@
 namespace mppi::diagnose {
 namespace {
 
+// The lanes' steps, compiled for AVX-512, AVX2 and the baseline and chosen at load time.
+template <class M>
+MPPI_MULTIVERSION void step_lanes_kernel(const M& m, float* x, const float* u, float dt_s, int substeps,
+                                         float* scratch) {
+  constexpr int W = ReplayModel::kLanes;
+  for (int i = 0; i < substeps; ++i) m.template step<W>(Batch<M::kNx, W>{x}, ConstBatch<2, W>{u}, dt_s, scratch);
+}
+
 template <class M>
 class ReplayModelOf final : public ReplayModel {
  public:
-  explicit ReplayModelOf(M m) : m_(std::move(m)), scratch_(m_.scratch_floats(1)) {
+  explicit ReplayModelOf(M m)
+      : m_(std::move(m)), scratch_(m_.scratch_floats(1)), lane_scratch_(m_.scratch_floats(kLanes)) {
     static_assert(M::kNx <= kMaxStates, "raise ReplayModel::kMaxStates");
   }
   int states() const override { return M::kNx; }
@@ -28,10 +38,13 @@ class ReplayModelOf final : public ReplayModel {
     const float u[2] = {steer, throttle};
     m_.template step<1>(Batch<M::kNx, 1>{x}, ConstBatch<2, 1>{u}, dt_s, scratch_.data());
   }
+  void step_lanes(float* x, const float* u, float dt_s, int substeps) const override {
+    step_lanes_kernel(m_, x, u, dt_s, substeps, lane_scratch_.data());
+  }
 
  private:
   M m_;
-  mutable std::vector<float> scratch_;  // the model's per-step work space (the network's layers)
+  mutable std::vector<float> scratch_, lane_scratch_;  // the model's per-step work space (the network's layers)
 };
 
 // WithEffects<Base> around the nominal model; `file` carries its parameters.

@@ -2,8 +2,10 @@
 // The nominal model a diagnosis starts from, as a family of "nominal + effects" models: one
 // member per set of effect values: WithEffects<Model> (dynamics/with_effects.hpp) around any of
 // CorrectedNominalModels (tyre effects only where there are tyres).
-// The replay and the fits see a member through ReplayModel: one state vector, stepped one
-// sample at a time (offline work, so a virtual call per step is fine here).
+// The replay and the fits see a member through ReplayModel: one state vector stepped one sample
+// at a time, or kLanes of them side by side stepped together in SIMD (many segments of a
+// recording replayed at once, as the controller's rollouts run). One virtual call per step or
+// per row of lanes, never per lane.
 #include <memory>
 #include <string>
 #include <vector>
@@ -32,6 +34,7 @@ struct CommandDelays {
 class ReplayModel {
  public:
   static constexpr int kMaxStates = 64;
+  static constexpr int kLanes = 16;  // states stepped together by step_lanes
   SensorFaults sensor;
   CommandDelays command_delay;
   virtual ~ReplayModel() = default;
@@ -41,6 +44,9 @@ class ReplayModel {
   virtual void set_actuators(float* x, float steer, float throttle) const = 0;  // steady command
   virtual void advance_actuators(float* x, float steer, float throttle, float dt_s) const = 0;
   virtual void step(float* x, float steer, float throttle, float dt_s) const = 0;
+  // `substeps` steps of dt_s each for kLanes states side by side: state i of lane j at
+  // x[i * kLanes + j]; the commands u[j] (steer) and u[kLanes + j] (throttle).
+  virtual void step_lanes(float* x, const float* u, float dt_s, int substeps) const = 0;
 };
 
 class ModelFamily {

@@ -25,95 +25,195 @@ std::vector<Segment> make_segments(const DiagData& d, const std::vector<char>& m
   return out;
 }
 
-void predict_segment(const ReplayModel& model, const DiagData& d, const Segment& s,
-                     const ReplayOptions& o, double* out) {
-  float x[ReplayModel::kMaxStates];
-  VehicleState vs;
-  const std::size_t k0 = s.start;
-  // Sensor faults: the true velocities behind a measurement, and the commands that acted over a
-  // state-stamped interval (shifted by the time offset; the interval average of the held commands).
-  const SensorFaults& sf = model.sensor;
-  const double inv_scale = 1.0 / sf.speed_scale;
-  auto true_vx = [&](std::size_t k) { return static_cast<float>(d.vx[k] * inv_scale); };
-  auto true_vy = [&](std::size_t k) { return static_cast<float>(d.vy[k] * inv_scale); };
-  auto true_r = [&](std::size_t k) { return static_cast<float>(d.r[k] - sf.gyro_bias_radps); };
-  // Each command is read this many rows earlier: the states' time offset plus the channel's pure
-  // delay. A held command shifted by a fraction of a row averages over two recorded ones.
-  const double steer_shift_rows = (sf.time_offset_s + model.command_delay.steer_s) / d.dt_s;
-  const double throttle_shift_rows = (sf.time_offset_s + model.command_delay.throttle_s) / d.dt_s;
-  auto shifted = [&](std::size_t k, double shift_rows, double (DiagData::*over)(std::size_t) const) {
-    if (shift_rows == 0.0) return (d.*over)(k);
+namespace {
+
+// How a model reads the recording: a measurement as the true state behind it (the member's
+// sensor faults), and the commands that acted over a state-stamped interval (shifted by the time
+// offset and the pure delays; a shift by a fraction of a row averages two recorded commands).
+class RecordingView {
+ public:
+  RecordingView(const ReplayModel& m, const DiagData& d)
+      : d_(d), sf_(m.sensor), inv_scale_(1.0 / m.sensor.speed_scale),
+        steer_shift_rows_((m.sensor.time_offset_s + m.command_delay.steer_s) / d.dt_s),
+        throttle_shift_rows_((m.sensor.time_offset_s + m.command_delay.throttle_s) / d.dt_s),
+        has_roll_(!d.roll.empty()) {}
+  float true_vx(std::size_t k) const { return static_cast<float>(d_.vx[k] * inv_scale_); }
+  float true_vy(std::size_t k) const { return static_cast<float>(d_.vy[k] * inv_scale_); }
+  float true_r(std::size_t k) const { return static_cast<float>(d_.r[k] - sf_.gyro_bias_radps); }
+  bool roll_at(std::size_t k) const { return has_roll_ && std::isfinite(d_.roll[k]); }
+  void command_over(std::size_t k, float* steer, float* throttle) const {
+    *steer = static_cast<float>(shifted(k, steer_shift_rows_, &DiagData::steer_over));
+    *throttle = static_cast<float>(shifted(k, throttle_shift_rows_, &DiagData::throttle_over));
+  }
+  // The measured states of row k put into a state (element i at x[i * stride]): positions and
+  // time as measured, velocities (and roll) blended towards the measurement by `gain`.
+  void force_measured(std::size_t k, float* x, int stride, int time_state, float gain) const {
+    auto at = [&](int i) -> float& { return x[static_cast<std::ptrdiff_t>(i) * stride]; };
+    at(state::kX) = static_cast<float>(d_.x[k]);
+    at(state::kY) = static_cast<float>(d_.y[k]);
+    at(state::kYaw) = static_cast<float>(d_.yaw[k]);
+    at(state::kVx) += gain * (true_vx(k) - at(state::kVx));
+    at(state::kVy) += gain * (true_vy(k) - at(state::kVy));
+    at(state::kYawRate) += gain * (true_r(k) - at(state::kYawRate));
+    if (roll_at(k)) at(state::kRoll) += gain * (static_cast<float>(d_.roll[k]) - at(state::kRoll));
+    at(time_state) = static_cast<float>(d_.t[k]);
+  }
+  // What the sensors would show of a state.
+  void measurement_of(const float* x, int stride, double* out5) const {
+    auto at = [&](int i) { return x[static_cast<std::ptrdiff_t>(i) * stride]; };
+    out5[0] = at(state::kVx) * sf_.speed_scale;
+    out5[1] = at(state::kVy) * sf_.speed_scale;
+    out5[2] = at(state::kYawRate) + sf_.gyro_bias_radps;
+    out5[3] = at(state::kX);
+    out5[4] = at(state::kY);
+  }
+
+ private:
+  double shifted(std::size_t k, double shift_rows, double (DiagData::*over)(std::size_t) const) const {
+    if (shift_rows == 0.0) return (d_.*over)(k);
     const double pos = static_cast<double>(k) - shift_rows;
     const double lo = std::floor(pos), w = pos - lo;
-    const auto at = [&](double i) { return static_cast<std::size_t>(std::clamp(i, 0.0, static_cast<double>(d.rows() - 1))); };
-    return (1 - w) * (d.*over)(at(lo)) + w * (d.*over)(at(lo + 1));
-  };
-  auto command_over = [&](std::size_t k, float* u) {
-    u[0] = static_cast<float>(shifted(k, steer_shift_rows, &DiagData::steer_over));
-    u[1] = static_cast<float>(shifted(k, throttle_shift_rows, &DiagData::throttle_over));
-  };
-  vs.x_m = static_cast<float>(d.x[k0]);
-  vs.y_m = static_cast<float>(d.y[k0]);
-  vs.yaw_rad = static_cast<float>(d.yaw[k0]);
-  vs.vx_mps = true_vx(k0);
-  vs.vy_mps = true_vy(k0);
-  vs.yaw_rate_radps = true_r(k0);
-  const bool has_roll = !d.roll.empty() && std::isfinite(d.roll[k0]);
-  if (has_roll) vs.roll_rad = static_cast<float>(d.roll[k0]);
-  model.init_state(vs, x);
-  const int time_state = model.time_index();
-  x[time_state] = static_cast<float>(d.t[k0]);
-  // Unmeasured states (actuator chains, wheel speeds): run the model over the history before
-  // the start with its measured states forced back to the recording at every sample, so that
-  // they settle where this model puts them; then start from the measured state.
-  std::size_t h = k0;
-  const int prime_rows = static_cast<int>(std::lround(o.prime_s / d.dt_s));
-  for (int i = 0; i < prime_rows && h > 0 && d.piece[h - 1] == d.piece[k0]; ++i) --h;
-  float u[2];
-  command_over(h, u);
-  model.set_actuators(x, u[0], u[1]);
-  // Velocities: a constant-gain observer (blend of the model's value and the measurement) once
-  // the full model runs, which takes sensor noise off the start state; the rest measured.
-  bool observing = false;
-  auto force_measured = [&](std::size_t k) {
-    x[state::kX] = static_cast<float>(d.x[k]);
-    x[state::kY] = static_cast<float>(d.y[k]);
-    x[state::kYaw] = static_cast<float>(d.yaw[k]);
-    const float g = observing ? static_cast<float>(o.observer_gain) : 1.f;
-    x[state::kVx] += g * (true_vx(k) - x[state::kVx]);
-    x[state::kVy] += g * (true_vy(k) - x[state::kVy]);
-    x[state::kYawRate] += g * (true_r(k) - x[state::kYawRate]);
-    if (has_roll && std::isfinite(d.roll[k])) x[state::kRoll] += g * (static_cast<float>(d.roll[k]) - x[state::kRoll]);
-    x[time_state] = static_cast<float>(d.t[k]);
-  };
-  for (std::size_t k = h; k < k0; ++k) {
-    force_measured(k);
-    const double dt = d.t[k + 1] - d.t[k];
-    const int n = std::max(1, static_cast<int>(std::lround(dt / o.substep_s)));
-    command_over(k, u);
-    if (static_cast<double>(k0 - k) * d.dt_s > o.wheel_prime_s) {  // actuators only
-      model.advance_actuators(x, u[0], u[1], static_cast<float>(dt));
-      continue;
-    }
-    for (int j = 0; j < n; ++j)
-      model.step(x, u[0], u[1], static_cast<float>(dt / n));
-    observing = true;
+    const auto row = [&](double i) { return static_cast<std::size_t>(std::clamp(i, 0.0, static_cast<double>(d_.rows() - 1))); };
+    return (1 - w) * (d_.*over)(row(lo)) + w * (d_.*over)(row(lo + 1));
   }
-  force_measured(k0);
-  for (int i = 0; i < s.len; ++i) {
-    const std::size_t k = k0 + static_cast<std::size_t>(i);
-    const double dt = d.t[k + 1] - d.t[k];
+  const DiagData& d_;
+  SensorFaults sf_;
+  double inv_scale_, steer_shift_rows_, throttle_shift_rows_;
+  bool has_roll_;
+};
+
+// Rows of command history before a start that the priming runs over (those of its own piece).
+int history_rows(const DiagData& d, std::size_t k0, const ReplayOptions& o) {
+  const int prime_rows = static_cast<int>(std::lround(o.prime_s / d.dt_s));
+  int h = 0;
+  while (h < prime_rows && k0 > static_cast<std::size_t>(h) && d.piece[k0 - static_cast<std::size_t>(h) - 1] == d.piece[k0]) ++h;
+  return h;
+}
+
+// Segments of one length and one history, replayed in lockstep: `lanes` = 1 (model.step) or
+// ReplayModel::kLanes (model.step_lanes; `count` <= kLanes real segments, the rest of the lanes
+// repeat the first). Lanes share each row's step: the mean of their sample intervals, so a
+// recording with timing jitter advances a lane by its own interval only on average.
+// Lane j replays segs[j] and writes its predictions to outs[j].
+void predict_lockstep(const ReplayModel& model, const DiagData& d, const Segment* const* segs, double* const* outs,
+                      int count, int history, int lanes, const ReplayOptions& o) {
+  constexpr int L = ReplayModel::kLanes;
+  const RecordingView view(model, d);
+  const int nx = model.states(), time_state = model.time_index(), len = segs[0]->len;
+  auto seg = [&](int j) -> const Segment& { return *segs[j < count ? j : 0]; };
+  // Unmeasured states (actuator chains, wheel speeds): run the model over the history before the
+  // start with its measured states forced back to the recording at every sample, so that they
+  // settle where this model puts them; then start from the measured state. The first part of
+  // the history runs the actuator chains alone, one lane at a time.
+  const int wheel_rows = [&] {
+    int r = 0;
+    while (r < history && static_cast<double>(history - r) * d.dt_s > o.wheel_prime_s) ++r;
+    return r;
+  }();
+  alignas(64) float xs[ReplayModel::kMaxStates * L];
+  float lane_state[ReplayModel::kMaxStates];
+  for (int j = 0; j < lanes; ++j) {
+    const std::size_t k0 = seg(j).start, h = k0 - static_cast<std::size_t>(history);
+    VehicleState vs;
+    vs.x_m = static_cast<float>(d.x[k0]);
+    vs.y_m = static_cast<float>(d.y[k0]);
+    vs.yaw_rad = static_cast<float>(d.yaw[k0]);
+    vs.vx_mps = view.true_vx(k0);
+    vs.vy_mps = view.true_vy(k0);
+    vs.yaw_rate_radps = view.true_r(k0);
+    if (view.roll_at(k0)) vs.roll_rad = static_cast<float>(d.roll[k0]);
+    model.init_state(vs, lane_state);
+    lane_state[time_state] = static_cast<float>(d.t[k0]);
+    float s, t;
+    view.command_over(h, &s, &t);
+    model.set_actuators(lane_state, s, t);
+    for (int r = 0; r < wheel_rows; ++r) {
+      const std::size_t k = h + static_cast<std::size_t>(r);
+      view.force_measured(k, lane_state, 1, time_state, 1.f);
+      view.command_over(k, &s, &t);
+      model.advance_actuators(lane_state, s, t, static_cast<float>(d.t[k + 1] - d.t[k]));
+    }
+    for (int i = 0; i < nx; ++i) xs[i * lanes + j] = lane_state[i];
+  }
+  float u[2 * L];
+  // One row of every lane: commands of row k_j = start_j + offset, one shared step.
+  auto advance_row = [&](std::ptrdiff_t offset) {
+    double dt = 0;
+    for (int j = 0; j < lanes; ++j) {
+      const std::size_t k = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(seg(j).start) + offset);
+      view.command_over(k, &u[j], &u[lanes + j]);
+      dt += d.t[k + 1] - d.t[k];
+    }
+    dt /= lanes;
     const int n = std::max(1, static_cast<int>(std::lround(dt / o.substep_s)));
     const float h_s = static_cast<float>(dt / n);
-    command_over(k, u);
-    for (int j = 0; j < n; ++j)
-      model.step(x, u[0], u[1], h_s);
-    double* o5 = out + static_cast<std::ptrdiff_t>(i) * kPredStride;
-    o5[0] = x[state::kVx] * sf.speed_scale;  // as the sensors would show them
-    o5[1] = x[state::kVy] * sf.speed_scale;
-    o5[2] = x[state::kYawRate] + sf.gyro_bias_radps;
-    o5[3] = x[state::kX];
-    o5[4] = x[state::kY];
+    if (lanes == 1) {
+      for (int i = 0; i < n; ++i) model.step(xs, u[0], u[1], h_s);
+    } else {
+      model.step_lanes(xs, u, h_s, n);
+    }
+  };
+  // Velocities: a constant-gain observer (blend of the model's value and the measurement) once
+  // the full model runs, which takes sensor noise off the start state.
+  float gain = 1.f;
+  for (int r = wheel_rows; r <= history; ++r) {
+    for (int j = 0; j < lanes; ++j)
+      view.force_measured(seg(j).start - static_cast<std::size_t>(history - r), xs + j, lanes, time_state, gain);
+    if (r == history) break;
+    advance_row(r - history);
+    gain = static_cast<float>(o.observer_gain);
+  }
+  for (int i = 0; i < len; ++i) {
+    advance_row(i);
+    for (int j = 0; j < count; ++j)
+      view.measurement_of(xs + j, lanes, outs[j] + static_cast<std::ptrdiff_t>(i) * kPredStride);
+  }
+}
+
+}  // namespace
+
+void predict_segment(const ReplayModel& model, const DiagData& d, const Segment& s,
+                     const ReplayOptions& o, double* out) {
+  const Segment* seg = &s;
+  predict_lockstep(model, d, &seg, &out, 1, history_rows(d, s.start, o), 1, o);
+}
+
+void predict_segments(const ReplayModel& model, const DiagData& d, const std::vector<Segment>& segs,
+                      const ReplayOptions& o, double* out) {
+  // Segments of one length and history go together, kLanes at a time; a group of fewer than
+  // kMinLockstepSegments is replayed one segment at a time.
+  struct Job {
+    int len, history;
+    const Segment* seg;
+    double* out;
+  };
+  std::vector<Job> jobs;
+  jobs.reserve(segs.size());
+  for (const Segment& s : segs) {
+    jobs.push_back({s.len, history_rows(d, s.start, o), &s, out});
+    out += static_cast<std::ptrdiff_t>(s.len) * kPredStride;
+  }
+  std::stable_sort(jobs.begin(), jobs.end(),
+                   [](const Job& a, const Job& b) { return a.len != b.len ? a.len < b.len : a.history < b.history; });
+  constexpr int L = ReplayModel::kLanes;
+  const Segment* lane_segs[L];
+  double* lane_outs[L];
+  for (std::size_t i = 0; i < jobs.size();) {
+    std::size_t n = 1;
+    while (i + n < jobs.size() && n < static_cast<std::size_t>(L) && jobs[i + n].len == jobs[i].len &&
+           jobs[i + n].history == jobs[i].history)
+      ++n;
+    for (std::size_t j = 0; j < n; ++j) {
+      lane_segs[j] = jobs[i + j].seg;
+      lane_outs[j] = jobs[i + j].out;
+    }
+    if (n >= kMinLockstepSegments) {
+      predict_lockstep(model, d, lane_segs, lane_outs, static_cast<int>(n), jobs[i].history, L, o);
+    } else {
+      for (std::size_t j = 0; j < n; ++j)
+        predict_lockstep(model, d, &lane_segs[j], &lane_outs[j], 1, jobs[i].history, 1, o);
+    }
+    i += n;
   }
 }
 
@@ -123,15 +223,14 @@ void segment_residuals(const ReplayModel& model, const DiagData& d,
   std::size_t total = 0;
   for (const auto& s : segs) total += static_cast<std::size_t>(s.len) * kChannels;
   res->resize(total);
-  std::vector<double> pred;
-  std::size_t w = 0;
+  std::vector<double> pred(total / kChannels * kPredStride);
+  predict_segments(model, d, segs, o, pred.data());
+  std::size_t w = 0, p = 0;
   for (const auto& s : segs) {
-    pred.resize(static_cast<std::size_t>(s.len) * kPredStride);
-    predict_segment(model, d, s, o, pred.data());
-    for (int i = 0; i < s.len; ++i) {
+    for (int i = 0; i < s.len; ++i, p += kPredStride) {
       const std::size_t k = s.start + static_cast<std::size_t>(i) + 1;
       for (int c = 0; c < kChannels; ++c) {
-        double e = (pred[static_cast<std::size_t>(i) * kPredStride + c] - d.channel(c, k)) / scale[c];
+        double e = (pred[p + static_cast<std::size_t>(c)] - d.channel(c, k)) / scale[c];
         if (!std::isfinite(e)) e = 1e3;  // a model that blew up: large, finite
         (*res)[w++] = std::clamp(e, -1e3, 1e3);
       }
@@ -178,13 +277,14 @@ std::vector<HorizonMetrics> horizon_metrics(const ReplayModel& model, const Diag
       out.push_back(m);
       continue;
     }
-    std::vector<double> pred(static_cast<std::size_t>(len) * kPredStride);
+    std::vector<double> pred(segs.size() * static_cast<std::size_t>(len) * kPredStride);
+    predict_segments(model, d, segs, o, pred.data());
     std::array<double, kChannels> se{}, sy{}, sy2{};
     double pos = 0;
-    for (const auto& s : segs) {
-      predict_segment(model, d, s, o, pred.data());
+    for (std::size_t n = 0; n < segs.size(); ++n) {
+      const Segment& s = segs[n];
       const std::size_t k = s.start + static_cast<std::size_t>(len);
-      const double* p = pred.data() + static_cast<std::size_t>(len - 1) * kPredStride;
+      const double* p = pred.data() + ((n + 1) * static_cast<std::size_t>(len) - 1) * kPredStride;
       for (int c = 0; c < kChannels; ++c) {
         const double y = ref.channel(c, k);
         const double e = std::isfinite(p[c]) ? p[c] - y : 1e3;

@@ -35,6 +35,16 @@ inline constexpr int kPredStride = 5;
 void predict_segment(const ReplayModel& model, const DiagData& d, const Segment& s,
                      const ReplayOptions& o, double* out);
 
+// The same for every segment of `segs`, one after the other in `out` (segment n's predictions
+// start at the sum of the earlier lengths x kPredStride). Segments of one length (and as much
+// command history before them) are replayed ReplayModel::kLanes at a time in SIMD, a group of
+// fewer than kMinLockstepSegments one at a time. On a recording with timing jitter the lanes share
+// each row's step (the mean of their intervals), so predictions differ from predict_segment's by
+// that jitter's effect; on a regular recording they are the same.
+inline constexpr std::size_t kMinLockstepSegments = 3;
+void predict_segments(const ReplayModel& model, const DiagData& d, const std::vector<Segment>& segs,
+                      const ReplayOptions& o, double* out);
+
 // Weighted residuals (prediction - measurement) / scale_c for every sample of every segment,
 // channels vx, vy, yaw_rate; appended to `res` (resized).
 void segment_residuals(const ReplayModel& model, const DiagData& d,

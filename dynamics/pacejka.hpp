@@ -5,6 +5,7 @@
 // that the batched model runs it in float (fast branch-free math) and the reference and
 // diagnostics in double (libm).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -116,7 +117,15 @@ inline bool PacejkaParams::is_valid(std::string* why) const {
   if (!(C > 0 && C < 2)) return fail("tyre: C (shape factor) must be in (0, 2)");
   if (!(D > 0)) return fail("tyre: D (peak factor) must be > 0");
   if (!(E < 1)) return fail("tyre: E (curvature factor) must be < 1");
-  // A tyre that pushes along the slip (mu < 0) would feed energy in: refuse it.
+  // A tyre that pushes along the slip (mu < 0) would feed energy in: refuse it. The sampled check
+  // costs some 10^4 transcendental calls, and a fit builds thousands of models of a few tyres:
+  // the last tyres that passed are remembered (per thread, exact match only).
+  const std::array<double, 6> key{B, C, D, E, Sh, Sv};
+  constexpr std::size_t kRemembered = 8;
+  thread_local std::array<std::array<double, 6>, kRemembered> passed{};
+  thread_local std::size_t passed_count = 0;
+  for (std::size_t i = 0; i < std::min(passed_count, kRemembered); ++i)
+    if (passed[i] == key) return true;
   const auto c = PacejkaCoeffs<double>::from(*this);
   for (int i = 0; i <= 4000; ++i) {
     const double s = 0.01 * i;  // [0, 40]
@@ -124,6 +133,7 @@ inline bool PacejkaParams::is_valid(std::string* why) const {
       return fail("tyre: mu(s) must be >= 0 for slips in [0, 40] (negative at s = " +
                   std::to_string(s) + ")");
   }
+  passed[passed_count++ % kRemembered] = key;
   return true;
 }
 
