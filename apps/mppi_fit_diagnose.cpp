@@ -153,7 +153,7 @@ int cmd_diagnose(DiagnoseArgs& args) {
   std::printf("held-out normalised RMSE at 1 s: %.4f -> %.4f (%.1f %% reduction)\n", r.headline_before,
               r.headline_after, 100 * r.heldout_rmse_reduction);
   if (test)
-    std::printf("test (%s; never seen by the fit or the validation): %.4f -> %.4f (%.1f %% reduction)%s\n",
+    std::printf("headline, test (%s; never seen by the fit or the validation): %.4f -> %.4f (%.1f %% reduction)%s\n",
                 test_name.c_str(), r.test.headline_nominal, r.test.headline_corrected, 100 * r.test.reduction,
                 r.selection.reliable ? "" : "; not written");
   std::printf("report: %s/report.md\n", o.out_dir.c_str());

@@ -127,4 +127,9 @@ TEST_CASE("a diagnosis scores its correction on test data that neither its fit n
   const auto j = nlohmann::json::parse(r.json);
   CHECK(j.at("test").at("data") == "the last 30 %");
   CHECK(j.at("test").at("rows") == test.rows());
+  // The headline is the test figure; the held-out one (the veto's) is kept beside it.
+  CHECK(j.at("headline").at("data") == "test");
+  CHECK(j.at("headline").at("normalized_rmse_after").get<double>() == Approx(r.test.headline_corrected));
+  CHECK(j.at("validation_headline").at("data") == "held-out");
+  CHECK(j.at("validation_headline").at("normalized_rmse_after").get<double>() == Approx(r.headline_after));
 }
