@@ -3,6 +3,7 @@
 // backward elimination and the re-try of an actuator's dynamics forms (selection_rounds.cpp), and
 // stability selection over block-bootstrap resamples (selection_stability.cpp). Internal: the
 // public entry point is select_effects.
+#include <deque>
 #include <functional>
 #include <random>
 #include <string>
@@ -76,6 +77,22 @@ std::vector<ParamSpec> joint_free_params(const std::vector<const EffectSpec*>& c
 // Effect parameters of `ids` copied from `from`, everything else at its default.
 EffectParams only(const std::vector<std::string>& ids, const EffectParams& from);
 std::vector<std::string> ids_of(const std::vector<const EffectSpec*>& cands, const std::vector<int>& chosen);
+
+// The training rows as fit problems: all segments, the fit part and the later block that
+// validates it, and the earlier fold (the fit part's halves).
+struct Problems {
+  FitProblem all, fit, val, early_fit, early_val;
+  int len = 0;       // rows per segment
+  double n_eff = 0;  // the fit part's effective sample count (the BIC's)
+};
+
+void make_problems(const DiagData& d, const ModelFamily& nominal, const std::vector<char>& train_mask,
+                   const SelectionOptions& opt, const ReplayOptions& replay, Problems* p, SelectionLog& log);
+
+// The candidates: the library's (or those asked for) that the nominal model takes, then the joint
+// ones of partner terms. joint_specs holds the joint candidates' specs (stable addresses).
+void make_candidates(const ModelFamily& nominal, const SelectionOptions& opt, std::vector<const EffectSpec*>* out,
+                     Members* members_out, std::deque<EffectSpec>* joint_specs);
 
 // Greedy forward selection over `pool` (indices into the candidates): each round fits every
 // remaining candidate on top of what is chosen and takes the one that lowers the validation cost
