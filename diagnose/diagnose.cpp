@@ -18,30 +18,12 @@
 #include "base/error.hpp"
 #include "diagnose/control_loss.hpp"
 #include "diagnose/plots.hpp"
+#include "diagnose/report_json.hpp"
 #include "diagnose/report_markdown.hpp"
 
 namespace mppi::diagnose {
-namespace {
 
 using json = nlohmann::ordered_json;
-
-json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
-// The values screened out of the recording (screen.hpp); at most kMaxListedFlags listed.
-json screening_json(const DiagData& d) {
-  json flags = json::array();
-  for (std::size_t i = 0; i < d.flags.size() && i < kMaxListedFlags; ++i) {
-    const ScreenFlag& f = d.flags[i];
-    // The value as text: JSON has no NaN or inf.
-    char value[32];
-    std::snprintf(value, sizeof value, "%.6g", f.value);
-    flags.push_back({{"file", f.file}, {"row", f.row}, {"t_s", num(f.t_s)}, {"column", f.column},
-                     {"value", value}, {"kind", f.kind}});
-  }
-  return {{"flagged", d.flags.size()}, {"rows_dropped", d.screened_rows}, {"flags", flags}};
-}
-
-}  // namespace
 
 DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, const DiagnoseOptions& o) {
   DiagnoseResult res;
@@ -132,120 +114,7 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
                                             "\nload with: mppi-sim --model corrected --model-params <this file>");
   }
 
-  // JSON.
-  json j;
-  j["log"] = d.source;
-  j["model"] = nominal.name();
-  j["params"] = o.params_source;
-  j["rows"] = d.rows();
-  j["control_loss_rows"] = res.control_loss_rows;
-  j["dt_s"] = d.dt_s;
-  j["holdout"] = o.holdout;
-  j["screening"] = screening_json(d);
-  j["selected"] = res.selection.selected;
-  j["reliable"] = res.selection.reliable;
-  j["verdict"] = res.selection.verdict;
-  j["sensor_faults"] = json::array();
-  for (const auto& id : res.selection.selected)
-    if (effect_spec(id).hook == EffectHook::kSensor) j["sensor_faults"].push_back(id);
-  json suspected = json::array();
-  for (const auto& s : res.selection.suspected) {
-    json ps;
-    for (const auto& p : s.params) ps[p.name] = {{"value", num(p.value)}, {"unit", p.unit}};
-    suspected.push_back({{"id", s.id}, {"reason", s.reason}, {"params", ps}});
-  }
-  j["suspected"] = suspected;
-  j["heldout_1s_normalized_rmse"] = {{"nominal", num(res.selection.heldout_nominal)},
-                                     {"corrected", num(res.selection.heldout_corrected)}};
-  json effects = json::array();
-  for (const auto& c : res.selection.candidates) {
-    json e;
-    e["id"] = c.id;
-    if (!c.joint_of.empty()) e["joint_of"] = c.joint_of;
-    json ps;
-    for (const auto& p : c.params) ps[p.name] = {{"value", num(p.value)}, {"stddev", num(p.stddev)}, {"unit", p.unit}};
-    e["params"] = ps;
-    e["validation_improvement"] = num(c.val_improvement);
-    e["bic_delta"] = num(c.bic_delta);
-    e["heldout_improvement"] = num(c.heldout_improvement);
-    e["selected"] = c.selected;
-    if (c.selected) e["round"] = c.round_selected;
-    if (!c.not_testable.empty()) e["not_testable"] = c.not_testable;
-    if (c.inclusion_frequency >= 0) e["inclusion_frequency"] = c.inclusion_frequency;
-    effects.push_back(e);
-  }
-  j["effects"] = effects;
-  json fp;
-  for (const auto& p : res.selection.final_params)
-    fp[p.name] = {{"value", num(p.value)}, {"stddev", num(p.stddev)}, {"unit", p.unit}};
-  j["final_params"] = fp;
-  json mm = json::array();
-  for (const auto& m : res.mismatch)
-    mm.push_back({{"channel", m.channel}, {"where", m.where}, {"magnitude", num(m.magnitude)},
-                  {"rms", num(m.rms)}, {"z", num(m.z)}, {"unit", m.unit}});
-  j["mismatch"] = mm;
-  auto fit_map = [&](const std::vector<HorizonMetrics>& ms) {
-    json f;
-    for (const auto& m : ms) {
-      char key[32];
-      std::snprintf(key, sizeof key, "%s", std::abs(m.horizon_s - d.dt_s) < 1e-9 ? "one_step" : "");
-      std::string k = key[0] ? key : (std::to_string(m.horizon_s).substr(0, 4) + "s");
-      for (int c = 0; c < kChannels; ++c) f[k][kChannelNames[c]] = num(m.fit_percent[c]);
-    }
-    return f;
-  };
-  auto rmse_map = [&](const std::vector<HorizonMetrics>& ms) {
-    json f;
-    for (const auto& m : ms) {
-      std::string k = std::abs(m.horizon_s - d.dt_s) < 1e-9 ? "one_step" : (std::to_string(m.horizon_s).substr(0, 4) + "s");
-      for (int c = 0; c < kChannels; ++c) f[k][kChannelNames[c]] = num(m.rmse[c]);
-      f[k]["normalized"] = num(m.normalized_rmse);
-    }
-    return f;
-  };
-  j["fit_before"] = fit_map(res.before);
-  j["fit_after"] = fit_map(res.after);
-  j["heldout_rmse_before"] = rmse_map(res.before);
-  j["heldout_rmse_after"] = rmse_map(res.after);
-  // The headline: on test data where there are some (data that neither the fit nor the veto saw),
-  // else on the held-out part, which also decided whether the correction is written.
-  const json validation_headline = {{"data", "held-out"},
-                                    {"horizon_s", o.headline_horizon_s},
-                                    {"normalized_rmse_before", num(res.headline_before)},
-                                    {"normalized_rmse_after", num(res.headline_after)},
-                                    {"reduction", num(res.heldout_rmse_reduction)}};
-  j["validation_headline"] = validation_headline;
-  j["headline"] = o.test ? json{{"data", "test"},
-                                {"horizon_s", o.headline_horizon_s},
-                                {"normalized_rmse_before", num(res.test.headline_nominal)},
-                                {"normalized_rmse_after", num(res.test.headline_corrected)},
-                                {"reduction", num(res.test.reduction)}}
-                         : validation_headline;
-  for (int c = 0; c < kChannels; ++c) j["explained_share"][kChannelNames[c]] = num(res.explained_share[c]);
-  json left = json::array();
-  for (const auto& m : res.remaining)
-    left.push_back({{"channel", m.channel}, {"where", m.where}, {"magnitude", num(m.magnitude)},
-                    {"rms", num(m.rms)}, {"z", num(m.z)}, {"unit", m.unit}});
-  j["remaining"] = left;
-  json parts = json::array();
-  for (const auto& p : res.per_recording)
-    parts.push_back({{"recording", p.name}, {"normalized_rmse_before", num(p.before)}, {"normalized_rmse_after", num(p.after)},
-                     {"reduction", num(p.before > 0 ? 1.0 - p.after / p.before : 0.0)}});
-  j["per_recording"] = parts;
-  if (o.test)
-    j["test"] = {{"data", o.test_name.empty() ? o.test->source : o.test_name},
-                 {"rows", o.test->rows()},
-                 {"horizon_s", o.headline_horizon_s},
-                 {"normalized_rmse_before", num(res.test.headline_nominal)},
-                 {"normalized_rmse_after", num(res.test.headline_corrected)},
-                 {"reduction", num(res.test.reduction)},
-                 {"correction_written", res.selection.reliable},
-                 {"metrics_before", horizon_metrics_json(res.test.nominal)},
-                 {"metrics_after", horizon_metrics_json(res.test.corrected)}};
-  j["metrics_before"] = horizon_metrics_json(res.before);
-  j["metrics_after"] = horizon_metrics_json(res.after);
-  j["selection_log"] = res.selection.log;
-  j["model_file"] = res.model_file;
+  json j = report_json(d, nominal.name(), o, res);
   // The report's figures: the same data in report.json, the PNGs and report.html.
   std::optional<plot::Figure> regime_fig, overlay_fig;
   if (!o.out_dir.empty() && o.plots) {
