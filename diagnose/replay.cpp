@@ -136,21 +136,51 @@ void predict_lockstep(const ReplayModel& model, const DiagData& d, const Segment
     for (int i = 0; i < nx; ++i) xs[i * lanes + j] = lane_state[i];
   }
   float u[2 * L];
-  // One row of every lane: commands of row k_j = start_j + offset, one shared step.
+  double lane_dt[L];
+  float outlier_state[ReplayModel::kMaxStates];
+  // Substeps of one row's interval: about o.substep_s each.
+  auto substeps_of = [&](double dt) { return std::max(1, static_cast<int>(std::lround(dt / o.substep_s))); };
+  // One row of every lane: the commands and interval of row start_j + offset.
   auto advance_row = [&](std::ptrdiff_t offset) {
-    double dt = 0;
     for (int j = 0; j < lanes; ++j) {
       const std::size_t k = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(seg(j).start) + offset);
       view.command_over(k, &u[j], &u[lanes + j]);
-      dt += d.t[k + 1] - d.t[k];
+      lane_dt[j] = d.t[k + 1] - d.t[k];
     }
-    dt /= lanes;
-    const int n = std::max(1, static_cast<int>(std::lround(dt / o.substep_s)));
-    const float h_s = static_cast<float>(dt / n);
     if (lanes == 1) {
-      for (int i = 0; i < n; ++i) model.step(xs, u[0], u[1], h_s);
-    } else {
-      model.step_lanes(xs, u, h_s, n);
+      const int n = substeps_of(lane_dt[0]);
+      for (int i = 0; i < n; ++i) model.step(xs, u[0], u[1], static_cast<float>(lane_dt[0] / n));
+      return;
+    }
+    // The lanes whose interval is within kSharedStepTolerance of the median share one step, the
+    // mean of their intervals (timing jitter); a lane whose interval differs more (a missing row
+    // doubles it) takes its own steps from the same start, one lane at a time.
+    double sorted[L];
+    std::copy(lane_dt, lane_dt + lanes, sorted);
+    std::nth_element(sorted, sorted + lanes / 2, sorted + lanes);
+    const double median = sorted[lanes / 2];
+    auto shares = [&](int j) { return std::abs(lane_dt[j] - median) <= kSharedStepTolerance * median; };
+    double shared = 0;
+    int sharing = 0;
+    for (int j = 0; j < lanes; ++j)
+      if (shares(j)) {
+        shared += lane_dt[j];
+        ++sharing;
+      }
+    shared /= sharing;
+    int outliers[L], outlier_count = 0;
+    float before[ReplayModel::kMaxStates * L];
+    for (int j = 0; j < lanes; ++j)
+      if (!shares(j)) outliers[outlier_count++] = j;
+    if (outlier_count > 0) std::copy(xs, xs + nx * lanes, before);
+    const int n = substeps_of(shared);
+    model.step_lanes(xs, u, static_cast<float>(shared / n), n);
+    for (int i = 0; i < outlier_count; ++i) {
+      const int j = outliers[i];
+      for (int c = 0; c < nx; ++c) outlier_state[c] = before[c * lanes + j];
+      const int m = substeps_of(lane_dt[j]);
+      for (int q = 0; q < m; ++q) model.step(outlier_state, u[j], u[lanes + j], static_cast<float>(lane_dt[j] / m));
+      for (int c = 0; c < nx; ++c) xs[c * lanes + j] = outlier_state[c];
     }
   };
   // Velocities: a constant-gain observer (blend of the model's value and the measurement) once
