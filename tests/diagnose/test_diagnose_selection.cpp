@@ -417,14 +417,13 @@ TEST_CASE("a patch of low grip is named as a place, not as a change in time", "[
 }
 
 // The fast case of the one above: 30 s; the candidates: the patch, the change in time, the
-// tyre and a few other terms the turns show; two resamples.
+// tyre and a few other terms the turns show; the default stability selection (six resamples).
 TEST_CASE("a patch of low grip on a short recording is named as a place, not as a change in time", "[diagnose]") {
   const DiagData d = prepare(circles_over_patches(11, 30.0, {{8.0, 0.0}}), "circles over a patch");
   DiagnoseOptions o;
   o.plots = false;
   o.selection.candidates = {"grip_patch", "friction_change", "tire_saturation", "payload", "steer_gain", "steer_delay",
                             "load_transfer"};
-  o.selection.stability_resamples = 2;
   const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track"), o);
   const std::string named = mppi::test::joined(r.selection.selected);
   std::string log;
