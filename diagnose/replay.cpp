@@ -90,30 +90,41 @@ int history_rows(const DiagData& d, std::size_t k0, const ReplayOptions& o) {
   return h;
 }
 
-// Segments of one length and one history, replayed in lockstep: `lanes` = 1 (model.step) or
-// ReplayModel::kLanes (model.step_lanes; `count` <= kLanes real segments, the rest of the lanes
-// repeat the first). Lanes share each row's step: the mean of their sample intervals, so a
-// recording with timing jitter advances a lane by its own interval only on average.
-// Lane j replays segs[j] and writes its predictions to outs[j].
+// Segments of one length replayed in lockstep: `lanes` = 1 (model.step) or ReplayModel::kLanes
+// (model.step_lanes; `count` <= kLanes real segments, the rest of the lanes repeat the first).
+// Lane j replays segs[j] after histories[j] rows of command history and writes its predictions to
+// outs[j]. The rows are counted back from the segments' starts, so every lane reaches its start
+// on the same row; a lane with a shorter history joins on its first row of history (until then
+// its state is stepped but not used). Lanes share each row's step: the mean of the sample
+// intervals of the lanes that have joined, so a recording with timing jitter advances a lane by
+// its own interval only on average.
 void predict_lockstep(const ReplayModel& model, const DiagData& d, const Segment* const* segs, double* const* outs,
-                      int count, int history, int lanes, const ReplayOptions& o) {
+                      const int* histories, int count, int lanes, const ReplayOptions& o) {
   constexpr int L = ReplayModel::kLanes;
   const RecordingView view(model, d);
   const int nx = model.states(), time_state = model.time_index(), len = segs[0]->len;
   auto seg = [&](int j) -> const Segment& { return *segs[j < count ? j : 0]; };
+  auto history_of = [&](int j) { return histories[j < count ? j : 0]; };
+  const int history = *std::max_element(histories, histories + count);
+  auto joins_at = [&](int j) { return history - history_of(j); };  // the row a lane joins on
+  // The data row of lane j on row r (r = history: its segment's start).
+  auto data_row = [&](int j, int r) {
+    return static_cast<std::size_t>(static_cast<std::ptrdiff_t>(seg(j).start) + r - history);
+  };
   // Unmeasured states (actuator chains, wheel speeds): run the model over the history before the
   // start with its measured states forced back to the recording at every sample, so that they
-  // settle where this model puts them; then start from the measured state. The first part of
-  // the history runs the actuator chains alone, one lane at a time.
+  // settle where this model puts them; then start from the measured state. The rows more than
+  // o.wheel_prime_s before the start run the actuator chains alone, one lane at a time.
   const int wheel_rows = [&] {
     int r = 0;
     while (r < history && static_cast<double>(history - r) * d.dt_s > o.wheel_prime_s) ++r;
     return r;
   }();
   alignas(64) float xs[ReplayModel::kMaxStates * L];
-  float lane_state[ReplayModel::kMaxStates];
-  for (int j = 0; j < lanes; ++j) {
-    const std::size_t k0 = seg(j).start, h = k0 - static_cast<std::size_t>(history);
+  // Lane j's start state at its first row of history, its chains run over the chain-only rows.
+  auto start_lane = [&](int j) {
+    float lane_state[ReplayModel::kMaxStates];
+    const std::size_t k0 = seg(j).start;
     VehicleState vs;
     vs.x_m = static_cast<float>(d.x[k0]);
     vs.y_m = static_cast<float>(d.y[k0]);
@@ -125,25 +136,33 @@ void predict_lockstep(const ReplayModel& model, const DiagData& d, const Segment
     model.init_state(vs, lane_state);
     lane_state[time_state] = static_cast<float>(d.t[k0]);
     float s, t;
-    view.command_over(h, &s, &t);
+    view.command_over(data_row(j, joins_at(j)), &s, &t);
     model.set_actuators(lane_state, s, t);
-    for (int r = 0; r < wheel_rows; ++r) {
-      const std::size_t k = h + static_cast<std::size_t>(r);
+    for (int r = joins_at(j); r < wheel_rows; ++r) {
+      const std::size_t k = data_row(j, r);
       view.force_measured(k, lane_state, 1, time_state, 1.f);
       view.command_over(k, &s, &t);
       model.advance_actuators(lane_state, s, t, static_cast<float>(d.t[k + 1] - d.t[k]));
     }
     for (int i = 0; i < nx; ++i) xs[i * lanes + j] = lane_state[i];
-  }
+  };
+  for (int j = 0; j < lanes; ++j) start_lane(j);  // a lane that joins later is started again then
   float u[2 * L];
   double lane_dt[L];
+  bool joined[L];
   float outlier_state[ReplayModel::kMaxStates];
   // Substeps of one row's interval: about o.substep_s each.
   auto substeps_of = [&](double dt) { return std::max(1, static_cast<int>(std::lround(dt / o.substep_s))); };
-  // One row of every lane: the commands and interval of row start_j + offset.
-  auto advance_row = [&](std::ptrdiff_t offset) {
+  // Row r of every lane: the commands and interval of its data row (lanes that have not joined:
+  // no command, the shared step).
+  auto advance_row = [&](int r) {
     for (int j = 0; j < lanes; ++j) {
-      const std::size_t k = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(seg(j).start) + offset);
+      joined[j] = r >= joins_at(j);
+      if (!joined[j]) {
+        u[j] = u[lanes + j] = 0.f;
+        continue;
+      }
+      const std::size_t k = data_row(j, r);
       view.command_over(k, &u[j], &u[lanes + j]);
       lane_dt[j] = d.t[k + 1] - d.t[k];
     }
@@ -156,14 +175,20 @@ void predict_lockstep(const ReplayModel& model, const DiagData& d, const Segment
     // mean of their intervals (timing jitter); a lane whose interval differs more (a missing row
     // doubles it) takes its own steps from the same start, one lane at a time.
     double sorted[L];
-    std::copy(lane_dt, lane_dt + lanes, sorted);
-    std::nth_element(sorted, sorted + lanes / 2, sorted + lanes);
-    const double median = sorted[lanes / 2];
-    auto shares = [&](int j) { return std::abs(lane_dt[j] - median) <= kSharedStepTolerance * median; };
+    int joined_count = 0;
+    for (int j = 0; j < lanes; ++j)
+      if (joined[j]) sorted[joined_count++] = lane_dt[j];
+    const auto [min_dt, max_dt] = std::minmax_element(sorted, sorted + joined_count);
+    double median = *min_dt;  // when max - min <= tolerance x min, every lane is within it of the median
+    if (*max_dt - *min_dt > kSharedStepTolerance * *min_dt) {
+      std::nth_element(sorted, sorted + joined_count / 2, sorted + joined_count);
+      median = sorted[joined_count / 2];
+    }
+    auto shares = [&](int j) { return !joined[j] || std::abs(lane_dt[j] - median) <= kSharedStepTolerance * median; };
     double shared = 0;
     int sharing = 0;
     for (int j = 0; j < lanes; ++j)
-      if (shares(j)) {
+      if (joined[j] && shares(j)) {
         shared += lane_dt[j];
         ++sharing;
       }
@@ -184,17 +209,21 @@ void predict_lockstep(const ReplayModel& model, const DiagData& d, const Segment
     }
   };
   // Velocities: a constant-gain observer (blend of the model's value and the measurement) once
-  // the full model runs, which takes sensor noise off the start state.
-  float gain = 1.f;
+  // the full model runs, which takes sensor noise off the start state: raw on a lane's first row
+  // of the full model, then blended by o.observer_gain.
   for (int r = wheel_rows; r <= history; ++r) {
-    for (int j = 0; j < lanes; ++j)
-      view.force_measured(seg(j).start - static_cast<std::size_t>(history - r), xs + j, lanes, time_state, gain);
+    for (int j = 0; j < lanes; ++j) {
+      const int first_full_row = std::max(wheel_rows, joins_at(j));
+      if (r < first_full_row) continue;
+      if (r == first_full_row && r > wheel_rows) start_lane(j);  // it joins now
+      const float gain = r == first_full_row ? 1.f : static_cast<float>(o.observer_gain);
+      view.force_measured(data_row(j, r), xs + j, lanes, time_state, gain);
+    }
     if (r == history) break;
-    advance_row(r - history);
-    gain = static_cast<float>(o.observer_gain);
+    advance_row(r);
   }
   for (int i = 0; i < len; ++i) {
-    advance_row(i);
+    advance_row(history + i);
     for (int j = 0; j < count; ++j)
       view.measurement_of(xs + j, lanes, outs[j] + static_cast<std::ptrdiff_t>(i) * kPredStride);
   }
@@ -205,12 +234,14 @@ void predict_lockstep(const ReplayModel& model, const DiagData& d, const Segment
 void predict_segment(const ReplayModel& model, const DiagData& d, const Segment& s,
                      const ReplayOptions& o, double* out) {
   const Segment* seg = &s;
-  predict_lockstep(model, d, &seg, &out, 1, history_rows(d, s.start, o), 1, o);
+  const int history = history_rows(d, s.start, o);
+  predict_lockstep(model, d, &seg, &out, &history, 1, 1, o);
 }
 
 void predict_segments(const ReplayModel& model, const DiagData& d, const std::vector<Segment>& segs,
                       const ReplayOptions& o, double* out) {
-  // Segments of one length and history go together, kLanes at a time; a group of fewer than
+  // Segments of one length go together, kLanes at a time, longest history first (so that the
+  // lanes of a group wait as little as possible for each other); a group of fewer than
   // kMinLockstepSegments is replayed one segment at a time.
   struct Job {
     int len, history;
@@ -224,24 +255,24 @@ void predict_segments(const ReplayModel& model, const DiagData& d, const std::ve
     out += static_cast<std::ptrdiff_t>(s.len) * kPredStride;
   }
   std::stable_sort(jobs.begin(), jobs.end(),
-                   [](const Job& a, const Job& b) { return a.len != b.len ? a.len < b.len : a.history < b.history; });
+                   [](const Job& a, const Job& b) { return a.len != b.len ? a.len < b.len : a.history > b.history; });
   constexpr int L = ReplayModel::kLanes;
   const Segment* lane_segs[L];
   double* lane_outs[L];
+  int lane_histories[L];
   for (std::size_t i = 0; i < jobs.size();) {
     std::size_t n = 1;
-    while (i + n < jobs.size() && n < static_cast<std::size_t>(L) && jobs[i + n].len == jobs[i].len &&
-           jobs[i + n].history == jobs[i].history)
-      ++n;
+    while (i + n < jobs.size() && n < static_cast<std::size_t>(L) && jobs[i + n].len == jobs[i].len) ++n;
     for (std::size_t j = 0; j < n; ++j) {
       lane_segs[j] = jobs[i + j].seg;
       lane_outs[j] = jobs[i + j].out;
+      lane_histories[j] = jobs[i + j].history;
     }
     if (n >= kMinLockstepSegments) {
-      predict_lockstep(model, d, lane_segs, lane_outs, static_cast<int>(n), jobs[i].history, L, o);
+      predict_lockstep(model, d, lane_segs, lane_outs, lane_histories, static_cast<int>(n), L, o);
     } else {
       for (std::size_t j = 0; j < n; ++j)
-        predict_lockstep(model, d, &lane_segs[j], &lane_outs[j], 1, jobs[i].history, 1, o);
+        predict_lockstep(model, d, &lane_segs[j], &lane_outs[j], &lane_histories[j], 1, 1, o);
     }
     i += n;
   }

@@ -36,13 +36,13 @@ void predict_segment(const ReplayModel& model, const DiagData& d, const Segment&
                      const ReplayOptions& o, double* out);
 
 // The same for every segment of `segs`, one after the other in `out` (segment n's predictions
-// start at the sum of the earlier lengths x kPredStride). Segments of one length (and as much
-// command history before them) are replayed ReplayModel::kLanes at a time in SIMD, a group of
-// fewer than kMinLockstepSegments one at a time. The lanes share each row's step: the mean of the
-// intervals of the lanes within kSharedStepTolerance of their median; a lane whose interval
-// differs more (a missing row) is stepped on its own for that row. So on a recording with timing
-// jitter the predictions differ from predict_segment's by that jitter's effect; on a regular one,
-// gaps included, they are the same.
+// start at the sum of the earlier lengths x kPredStride). Segments of one length are replayed
+// ReplayModel::kLanes at a time in SIMD (a lane with less command history before its start joins
+// its group later), a group of fewer than kMinLockstepSegments one at a time. The lanes share each
+// row's step: the mean of the intervals of the lanes within kSharedStepTolerance of their median;
+// a lane whose interval differs more (a missing row) is stepped on its own for that row. So on a
+// recording with timing jitter the predictions differ from predict_segment's by that jitter's
+// effect; on a regular one, gaps included, they are the same.
 inline constexpr std::size_t kMinLockstepSegments = 3;
 inline constexpr double kSharedStepTolerance = 0.1;
 void predict_segments(const ReplayModel& model, const DiagData& d, const std::vector<Segment>& segs,

@@ -34,6 +34,8 @@
 #include <type_traits>
 #include <utility>
 
+#include "base/batch.hpp"
+#include "base/fast_math.hpp"
 #include "dynamics/autorally_nn.hpp"
 #include "dynamics/double_track.hpp"
 #include "dynamics/effects.hpp"
@@ -166,6 +168,35 @@ class WithEffects {
     return play;
   }
 
+  // advance_chain for W lanes at once: the chain of lane j is x[first + i][j], its input u[j];
+  // the outputs go to out[j]. The same operations as advance_chain, stage by stage.
+  template <int W>
+  static void advance_chain_lanes(Batch<kNx, W> x, int first, const float* u, const ChainCoeffs& k,
+                                  float* out) noexcept {
+    float in[W];
+    std::copy(u, u + W, in);
+    for (int i = 0; i < kDelayStages; ++i) {
+      float* const stage = x[first + i];
+      MPPI_SIMD_LOOP
+      for (int j = 0; j < W; ++j) {
+        stage[j] += k.a_delay * (in[j] - stage[j]);
+        in[j] = stage[j];
+      }
+    }
+    float* const lag = x[first + kDelayStages];
+    float* const play = x[first + kDelayStages + 1];
+    MPPI_SIMD_LOOP
+    for (int j = 0; j < W; ++j) lag[j] += std::clamp(k.a_lag * (in[j] - lag[j]), -k.max_step, k.max_step);
+    if (k.backlash > 0.f) {
+      const float half = 0.5f * k.backlash;
+      MPPI_SIMD_LOOP
+      for (int j = 0; j < W; ++j) play[j] = std::clamp(play[j], lag[j] - half, lag[j] + half);
+    } else {
+      std::copy(lag, lag + W, play);
+    }
+    std::copy(play, play + W, out);
+  }
+
   // Actuator chains only, one state (used to prime them from a command history).
   void advance_actuators(float* x, float steer, float throttle, float dt_s) const noexcept {
     const ActuatorCoeffs k = actuator_coeffs(effects_, dt_s);
@@ -227,37 +258,31 @@ class WithEffects {
   template <int W>
   void step(Batch<kNx, W> x, ConstBatch<kNu, W> u, float dt_s, float* scratch) const noexcept {
     const ActuatorCoeffs k = actuator_coeffs(effects_, dt_s);
+    // Every stage below runs over all lanes at once (a SIMD loop per stage), in the order the
+    // physics needs: actuator chains, command maps, then the forces from the start-of-step state.
     float applied[kNu * W];  // the command the base model sees, per lane
+    float* const steer = applied + control::kSteer * W;
+    float* const throttle = applied + control::kThrottle * W;
     float ax[W], ay[W];      // force hook: body-axis accelerations from the start-of-step state
     float yaw_accel[W];      // and the yaw acceleration [rad/s^2]
     float other_w[W];        // weight of the other grip (after a change, on the patch) per lane
+    advance_chain_lanes<W>(x, kSteerChain, u[control::kSteer], k.steer, steer);
+    advance_chain_lanes<W>(x, kThrottleChain, u[control::kThrottle], k.throttle, throttle);
+    MPPI_SIMD_LOOP
+    for (int j = 0; j < W; ++j) steer[j] = applied_steer(steer[j]);
+    if (speed_loop_)
+      for (int j = 0; j < W; ++j)
+        throttle[j] = speed_loop_throttle(throttle[j], motor_rim_speed<W>(x, j), &x[kSpeedLoopIntegral][j], dt_s);
+    MPPI_SIMD_LOOP
+    for (int j = 0; j < W; ++j) throttle[j] = applied_throttle(throttle[j]);
+    if (esc_) {
+      MPPI_SIMD_LOOP
+      for (int j = 0; j < W; ++j) throttle[j] = esc_throttle(throttle[j], motor_rim_speed<W>(x, j));
+    }
+    body_accelerations<W>(x, steer, ax, ay, yaw_accel);
+    other_grip_weights<W>(x, other_w);
     int before_lanes = 0, blended_lanes = 0;
     for (int j = 0; j < W; ++j) {
-      float chain_s[kChain], chain_t[kChain];
-      for (int i = 0; i < kChain; ++i) {
-        chain_s[i] = x[kSteerChain + i][j];
-        chain_t[i] = x[kThrottleChain + i][j];
-      }
-      const float s = advance_chain(chain_s, u[control::kSteer][j], k.steer);
-      float t = advance_chain(chain_t, u[control::kThrottle][j], k.throttle);
-      for (int i = 0; i < kChain; ++i) {
-        x[kSteerChain + i][j] = chain_s[i];
-        x[kThrottleChain + i][j] = chain_t[i];
-      }
-      applied[control::kSteer * W + j] = applied_steer(s);
-      if (speed_loop_) t = speed_loop_throttle(t, motor_rim_speed<W>(x, j), &x[kSpeedLoopIntegral][j], dt_s);
-      applied[control::kThrottle * W + j] = applied_throttle(t);
-      const float vx = x[state::kVx][j];
-      float sy, cy;
-      fast_sincos(x[state::kYaw][j], &sy, &cy);
-      if (esc_) applied[control::kThrottle * W + j] = esc_throttle(applied[control::kThrottle * W + j], motor_rim_speed<W>(x, j));
-      float gx = grade_x_, gy = grade_y_;  // g x the ground's slope here (plane + bump)
-      if (bump_) add_bump_slope(x[state::kX][j], x[state::kY][j], &gx, &gy);
-      ax[j] = -drag_per_kg_ * vx * std::abs(vx) - (gx * cy + gy * sy);
-      ay[j] = -(-gx * sy + gy * cy);
-      yaw_accel[j] = 0.f;
-      if (rolling_) add_rolling_resistance(x, j, applied[control::kSteer * W + j], &ax[j], &ay[j], &yaw_accel[j]);
-      other_w[j] = other_grip_weight(x[kTime][j], x[state::kX][j], x[state::kY][j]);
       before_lanes += other_w[j] == 0.f;
       blended_lanes += other_w[j] > 0.f && other_w[j] < 1.f;
     }
@@ -295,22 +320,59 @@ class WithEffects {
   }
 
  private:
-  // Weight of the other grip at this time and place: 0 or 1 for a change in time; on the patch's
-  // discs a logistic edge kPatchEdge_m wide, snapped to 0 / 1 where it is within 1e-3 of them (so
-  // the car steps one base model away from the edge). Where discs overlap, the nearest edge
-  // inward counts (the largest weight).
+  // Weight of the other grip at each lane's time and place: 0 or 1 for a change in time; on the
+  // patch's discs a logistic edge kPatchEdge_m wide, snapped to 0 / 1 where it is within 1e-3 of
+  // them (so the car steps one base model away from the edge). Where discs overlap, the nearest
+  // edge inward counts (the largest weight).
   static constexpr float kPatchEdge_m = 0.25f;
-  float other_grip_weight(float t_s, float x_m, float y_m) const noexcept {
-    if (grip_changes_) return t_s < change_time_ ? 0.f : 1.f;
-    if (!patch_) return 1.f;  // only the nominal grip: after_ == before_
-    float z = 7.f;            // edge distance in edge widths, negative inside
-    for (int i = 0; i < discs_n_; ++i) {
-      const float dx = x_m - discs_[i].x_m, dy = y_m - discs_[i].y_m;
-      z = std::min(z, (std::sqrt(dx * dx + dy * dy) - discs_[i].radius_m) / kPatchEdge_m);
+  template <int W>
+  void other_grip_weights(Batch<kNx, W> x, float* w) const noexcept {
+    if (grip_changes_) {
+      for (int j = 0; j < W; ++j) w[j] = x[kTime][j] < change_time_ ? 0.f : 1.f;
+      return;
     }
-    if (z > 6.9f) return 0.f;
-    if (z < -6.9f) return 1.f;
-    return 1.f / (1.f + std::exp(z));
+    if (!patch_) {  // only the nominal grip: after_ == before_
+      std::fill(w, w + W, 1.f);
+      return;
+    }
+    float z[W];  // edge distance in edge widths, negative inside
+    std::fill(z, z + W, 7.f);
+    const float* const px = x[state::kX];
+    const float* const py = x[state::kY];
+    for (int i = 0; i < discs_n_; ++i) {
+      const Disc d = discs_[i];
+      MPPI_SIMD_LOOP
+      for (int j = 0; j < W; ++j) {
+        const float dx = px[j] - d.x_m, dy = py[j] - d.y_m;
+        z[j] = std::min(z[j], (std::sqrt(dx * dx + dy * dy) - d.radius_m) / kPatchEdge_m);
+      }
+    }
+    for (int j = 0; j < W; ++j) w[j] = z[j] > 6.9f ? 0.f : z[j] < -6.9f ? 1.f : 1.f / (1.f + std::exp(z[j]));
+  }
+  // Body-axis accelerations of the force hook from the start-of-step state: air drag, the
+  // ground's slope (plane and bump) and rolling resistance; `steer` is the applied steer per lane.
+  template <int W>
+  void body_accelerations(Batch<kNx, W> x, const float* steer, float* ax, float* ay,
+                          float* yaw_accel) const noexcept {
+    float gx[W], gy[W];  // g x the ground's slope here (plane + bump)
+    std::fill(gx, gx + W, grade_x_);
+    std::fill(gy, gy + W, grade_y_);
+    if (bump_)
+      for (int j = 0; j < W; ++j) add_bump_slope(x[state::kX][j], x[state::kY][j], &gx[j], &gy[j]);
+    const float* const vx = x[state::kVx];
+    const float* const yaw = x[state::kYaw];
+    MPPI_SIMD_LOOP
+    for (int j = 0; j < W; ++j) {
+      float sy, cy;
+      fast_sincos(yaw[j], &sy, &cy);
+      ax[j] = -drag_per_kg_ * vx[j] * std::abs(vx[j]) - (gx[j] * cy + gy[j] * sy);
+      ay[j] = -(-gx[j] * sy + gy[j] * cy);
+      yaw_accel[j] = 0.f;
+    }
+    if (rolling_) {
+      MPPI_SIMD_LOOP
+      for (int j = 0; j < W; ++j) add_rolling_resistance(x, j, steer[j], &ax[j], &ay[j], &yaw_accel[j]);
+    }
   }
   // Rolling resistance F0 tanh(v / 0.5) + b v against each axle's rolling speed v, along its
   // wheel: the rear along the body's x axis, the front turned by the wheel angle delta, so that
