@@ -49,7 +49,7 @@ std::vector<std::string> nominal_models() {
 // "Effect ids: aero_drag rolling_resistance ...": from the effect table.
 std::string effect_ids_help() {
   std::string out = "Effect ids:";
-  for (const EffectSpec& e : effect_library()) out += " " + e.id;
+  for (const EffectSpec& e : effect_library()) out += " " + e.id + (e.default_candidate ? "" : " (by name only)");
   return out;
 }
 

@@ -53,7 +53,7 @@ void make_candidates(const ModelFamily& nominal, const SelectionOptions& opt, st
   Members& members = *members_out;
   if (opt.candidates.empty()) {
     for (const auto& e : effect_library())
-      if (nominal.supports(e.id)) cands.push_back(&e);
+      if (e.default_candidate && nominal.supports(e.id)) cands.push_back(&e);
   } else {
     for (const auto& id : opt.candidates) {
       if (!nominal.supports(id))
@@ -67,18 +67,17 @@ void make_candidates(const ModelFamily& nominal, const SelectionOptions& opt, st
   // the other's error and can fail where the two together explain the data.
   members.assign(cands.size(), {});
   for (std::size_t i = 0; i < cands.size(); ++i) members[i] = {static_cast<int>(i)};
-  static const std::pair<const char*, const char*> kPartners[] = {{"steer_gain", "steer_offset"},
-                                                                   {"throttle_gain", "throttle_offset"},
-                                                                   {"motor_freewheel", "drag_brake"}};
-  for (const auto& [a, b] : kPartners) {
-    int ia = -1, ib = -1;
-    for (std::size_t i = 0; i < cands.size(); ++i) {
-      if (cands[i]->id == a) ia = static_cast<int>(i);
+  const std::size_t single_count = cands.size();
+  for (std::size_t pa = 0; pa < single_count; ++pa) {
+    const std::string& a = cands[pa]->id;
+    const std::string& b = cands[pa]->partner;
+    if (b.empty()) continue;
+    int ia = static_cast<int>(pa), ib = -1;
+    for (std::size_t i = 0; i < single_count; ++i)
       if (cands[i]->id == b) ib = static_cast<int>(i);
-    }
     if (ia < 0 || ib < 0) continue;
     EffectSpec joint = *cands[static_cast<std::size_t>(ia)];
-    joint.id = std::string(a) + "+" + b;
+    joint.id = a + "+" + b;
     joint.description = "joint: " + joint.description + "; " + cands[static_cast<std::size_t>(ib)]->description;
     const auto& more = cands[static_cast<std::size_t>(ib)]->params;
     joint.params.insert(joint.params.end(), more.begin(), more.end());

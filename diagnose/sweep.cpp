@@ -13,12 +13,13 @@
 namespace mppi::diagnose {
 namespace {
 
-// "Actuator dynamics" families: a pure delay and a first-order lag of the same actuator are
-// both its dynamics; at small sizes under sensor noise they are hard to tell apart. The sweep
-// reports this looser count next to (never instead of) the strict one.
+// "Actuator dynamics" families: a pure delay, a first-order lag, a rate limit and a play of one
+// actuator all hold back its response (EffectSpec::dynamics_of); at small sizes under sensor
+// noise they are hard to tell apart. The sweep reports this looser count next to (never instead
+// of) the strict one.
 std::string actuator_family(const std::string& id) {
-  if (id == "steer_delay" || id == "steer_lag") return "steer actuator dynamics";
-  if (id == "throttle_delay" || id == "throttle_lag") return "throttle actuator dynamics";
+  for (const EffectSpec& e : effect_table())
+    if (e.id == id && !e.dynamics_of.empty()) return e.dynamics_of + " actuator dynamics";
   return id;
 }
 

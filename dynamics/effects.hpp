@@ -59,6 +59,8 @@
 //                                         wheels' speed; single-track-core models only. With
 //                                         motor_freewheel (f = 1: no back-EMF braking at neutral)
 //                                         it is the neutral of a PWM ESC in drive-brake mode
+//             tyre_relaxation             the lateral force lags the slip over a rolling distance
+//                                         (declared in dynamics/effects/tyre_relaxation.hpp)
 //   sensor:   gyro_bias                   the yaw-rate gyro reads r + b
 //             speed_sensor_scale          the velocity sensor reads s (vx, vy)
 //             time_offset                 states are stamped t_off late against the commands.
@@ -83,11 +85,15 @@
 
 #include "base/error.hpp"
 #include "base/param_table.hpp"
+#include "dynamics/effect_spec.hpp"
+#include "dynamics/effects/effect_registry.hpp"
 #include "dynamics/vehicle_params.hpp"
 
 namespace mppi {
 
-struct EffectParams {
+// The built-in effects' parameters, and through its base those of the effects declared in files
+// of their own (dynamics/effects/effect_registry.hpp).
+struct EffectParams : effects::ParamsOfAll<effects::DeclaredEffects> {
   double steer_offset = 0.0;         // [-] added to the applied steer
   double steer_gain = 1.0;           // [-] scale of the applied steer
   double throttle_offset = 0.0;      // [-] added to the applied throttle
@@ -143,61 +149,21 @@ struct EffectParams {
   bool is_valid(std::string* why) const;
 };
 
-// Where an effect enters the physics of WithEffects<Model>.
-enum class EffectHook {
-  kActuator,  // transforms the command before the model sees it
-  kChassis,   // changes the model's tyre / chassis parameters (models with a single-track core)
-  kForce,     // adds a force along the body axes (inside the force balance where the model
-              // offers it, else after the model's step)
-  kSensor,    // changes what the recording shows (measured states, time stamps), not the car
-};
-
-struct EffectParamSpec {
-  const char* name;             // key in the corrected-model file (EffectParams field)
-  double EffectParams::*member;
-  const char* unit;
-  Range valid;                  // values a model accepts (is_valid)
-  double lo, hi;                // range a fit searches (fits are projected onto it)
-  double scale;                 // typical size: finite-difference step = 0.01 scale
-};
-
-// What a recording must contain for an effect to be identifiable from it (the diagnosis
-// measures it on the data; diagnose/identifiability.hpp).
-enum class Excitation {
-  kAny,         // any driving
-  kSteer,       // steering that changes (and turns the car). Also what a steering trim and a
-                // gyro bias need: at one steering command the trim, the steering gain, the tyre
-                // and a yaw-rate bias all give one number, the steady yaw-rate error there
-  kThrottle,    // throttle that changes (and changes the speed)
-  kCornering,   // lateral acceleration towards the tyres' limit
-  kSpeedRange,  // a range of speeds (speed-dependent forces)
-  kBraking,     // longitudinal acceleration and braking (pitch load transfer)
-  kSpeedCommand,  // a throttle channel that the recording declares a speed command (its metadata
-                  // line `# throttle_command: speed`): a stack that commands speeds, not throttle
-};
-
-// Leading parameters that a fit searches over the data instead of fitting them by least squares
-// (they move where an effect acts, and the cost is flat far from the right value).
-enum class DataGrid {
-  kNone,
-  kTime,   // params[0] is a time within the recording
-  kPlace,  // params[0], params[1] are a place (x, y) the car visited
-};
-inline int grid_param_count(DataGrid g) { return g == DataGrid::kTime ? 1 : g == DataGrid::kPlace ? 2 : 0; }
-
-struct EffectSpec {
-  std::string id;               // effect id, e.g. "steer_delay"
-  std::string description;      // one line, physical meaning
-  EffectHook hook;
-  std::vector<EffectParamSpec> params;
-  std::vector<double> grid;     // start values searched for params[0] (empty: its default)
-  DataGrid data_grid = DataGrid::kNone;  // leading params searched over the data (not LM-fitted)
-  Excitation needs = Excitation::kAny;
-  // The actuator whose dynamics this is ("steer", "throttle"; empty: none). A delay, a lag, a rate
-  // limit and a play of one actuator all hold back its response, and a recording with smooth
-  // commands may not tell these forms apart.
-  std::string dynamics_of = {};
-};
+// An effect declared in a file of its own as an EffectSpec of the table.
+template <class E>
+EffectSpec effect_spec_of() {
+  const EffectDecl<typename E::Params> d = E::decl();
+  EffectSpec spec{d.id, d.description, d.hook, {}, d.grid, d.data_grid, d.needs, d.dynamics_of, d.partner,
+                  d.default_candidate};
+  for (const auto& p : d.params)
+    spec.params.push_back({p.name, static_cast<double EffectParams::*>(p.member), p.unit, p.valid, p.lo, p.hi, p.scale});
+  return spec;
+}
+// The built-in effects followed by the declared ones (dynamics/effects/effect_registry.hpp).
+inline std::vector<EffectSpec> with_declared_effects(std::vector<EffectSpec> table) {
+  for_each_type(effects::DeclaredEffects{}, [&]<class E>() { table.push_back(effect_spec_of<E>()); });
+  return table;
+}
 
 // Every effect, in a fixed order.
 inline const std::vector<EffectSpec>& effect_table() {
@@ -206,7 +172,7 @@ inline const std::vector<EffectSpec>& effect_table() {
   using X = Excitation;
   static const Range kAny = any_finite(), kNonNeg = non_negative(), kScale = {0.05, kInf, Bounds::kOpen},
                      kGrade = open(-0.5, 0.5);
-  static const std::vector<EffectSpec> table = {
+  static const std::vector<EffectSpec> table = with_declared_effects({
       {"aero_drag", "extra air drag F = -c vx|vx|", H::kForce,
        {{"aero_drag_kgpm", &E::aero_drag_kgpm, "N s^2/m^2", kAny, -0.05, 3.0, 0.1}}, {}, DataGrid::kNone, X::kSpeedRange},
       {"rolling_resistance", "extra rolling resistance F = -(F0 tanh(v/0.5) + b v) along each wheel, shared by the axles as the static load", H::kForce,
@@ -224,7 +190,8 @@ inline const std::vector<EffectSpec>& effect_table() {
       {"steer_offset", "steering bias (trim)", H::kActuator,
        {{"steer_offset", &E::steer_offset, "1 (normalised steer)", kAny, -0.4, 0.4, 0.02}}, {}, DataGrid::kNone, X::kSteer},
       {"steer_gain", "steering scale (servo / linkage gain)", H::kActuator,
-       {{"steer_gain", &E::steer_gain, "1", kAny, 0.3, 2.0, 0.1}}, {0.7, 1.0, 1.3}, DataGrid::kNone, X::kSteer},
+       {{"steer_gain", &E::steer_gain, "1", kAny, 0.3, 2.0, 0.1}}, {0.7, 1.0, 1.3}, DataGrid::kNone, X::kSteer, {},
+       "steer_offset"},
       {"throttle_offset", "throttle bias / motor dead band", H::kActuator,
        {{"throttle_offset", &E::throttle_offset, "1 (normalised throttle)", kAny, -0.4, 0.4, 0.02}}, {}, DataGrid::kNone, X::kThrottle},
       {"tire_saturation", "tyre friction limit (Pacejka peak D x k) and cornering stiffness (x s)", H::kChassis,
@@ -264,7 +231,8 @@ inline const std::vector<EffectSpec>& effect_table() {
        {{"grade_x", &E::grade_x, "1 (dz/dx)", kGrade, -0.3, 0.3, 0.01},
         {"grade_y", &E::grade_y, "1 (dz/dy)", kGrade, -0.3, 0.3, 0.01}}, {}, DataGrid::kNone, X::kAny},
       {"throttle_gain", "motor / ESC gain: throttle u -> g u", H::kActuator,
-       {{"throttle_gain", &E::throttle_gain, "1", kScale, 0.3, 2.5, 0.1}}, {0.7, 1.0, 1.4}, DataGrid::kNone, X::kThrottle},
+       {{"throttle_gain", &E::throttle_gain, "1", kScale, 0.3, 2.5, 0.1}}, {0.7, 1.0, 1.4}, DataGrid::kNone, X::kThrottle,
+       {}, "throttle_offset"},
       // k is searched down to -0.9: a fit of a soft linkage (k = -0.4) that also takes up other
       // large-steer errors can end below -0.6, and a fit at the range's end is only a bound.
       {"steer_cubic", "nonlinear steering linkage: s -> s + k s^3", H::kActuator,
@@ -288,7 +256,7 @@ inline const std::vector<EffectSpec>& effect_table() {
       {"motor_freewheel", "the motor's back-EMF braking acts only while the PWM is on: F_stall (u - v/v_nl ((1-f) + f|u|))",
        H::kChassis,
        {{"freewheel_share", &E::motor_freewheel_share, "1", closed(0.0, 1.0), 0.0, 1.0, 0.1}}, {0.3, 0.7},
-       DataGrid::kNone, X::kThrottle},
+       DataGrid::kNone, X::kThrottle, {}, "drag_brake"},
       {"drag_brake", "the ESC's drag brake: at neutral command a brake torque that decelerates the car by a_db",
        H::kChassis,
        {{"drag_brake_mps2", &E::drag_brake_mps2, "m/s^2", kNonNeg, 0.0, 8.0, 0.5}}, {1.0, 3.0},
@@ -305,7 +273,7 @@ inline const std::vector<EffectSpec>& effect_table() {
         {"speed_loop_gain", &E::speed_loop_gain, "1 per m/s", positive(), 0.02, 5.0, 0.1},
         {"speed_loop_integral_gain", &E::speed_loop_integral_gain, "1 per m", kNonNeg, 0.0, 20.0, 0.2}},
        {4.0, 8.0, 15.0}, DataGrid::kNone, X::kSpeedCommand},
-  };
+  });
   return table;
 }
 

@@ -25,12 +25,15 @@
 //     (SingleTrackParams defaults; the network models that car).
 // State: the base's kNx, then time [s], then the steer and throttle actuator chains
 // (kActuatorDelayStages delay stages, one lag stage with the rate limit, one play stage for the
-// backlash, whose output is applied), then the speed loop's integral of its speed error [m].
+// backlash, whose output is applied), then the speed loop's integral of its speed error [m], then
+// the states of the effects declared in files of their own (dynamics/effects/effect_registry.hpp),
+// whose terms it folds over: tyre_relaxation adds its lag to the force hook.
 #include <algorithm>
 #include <cmath>
 #include <iterator>
 #include <numbers>
 #include <string>
+#include <tuple>
 #include <type_traits>
 #include <utility>
 
@@ -78,7 +81,8 @@ class WithEffects {
   static constexpr int kSteerChain = kTime + 1;
   static constexpr int kThrottleChain = kSteerChain + kChain;
   static constexpr int kSpeedLoopIntegral = kThrottleChain + kChain;
-  static constexpr int kNx = kSpeedLoopIntegral + 1;
+  static constexpr int kDeclaredStates = kSpeedLoopIntegral + 1;  // the declared effects' states
+  static constexpr int kNx = kDeclaredStates + effects::StatesOfAll<effects::DeclaredEffects>::kCount;
   static constexpr int kNu = 2;
   static constexpr int kOmega = [] {  // wheel speeds, as in the base (-1: none)
     if constexpr (requires { Base::kOmega; }) return Base::kOmega;
@@ -143,6 +147,11 @@ class WithEffects {
     loop_gain_per_mps_ = static_cast<float>(effects_.speed_loop_gain);
     loop_integral_gain_per_m_ = static_cast<float>(effects_.speed_loop_integral_gain);
     loop_feedforward_per_mps_ = static_cast<float>(1.0 / car.no_load_speed_mps);
+    if constexpr (kChassisEffects)
+      for_each_type(effects::DeclaredEffects{}, [&]<class E>() {
+        std::get<typename E::Term>(declared_) =
+            typename E::Term(static_cast<const typename E::Params&>(effects_), single_track_core(before_.params()));
+      });
   }
 
   const Base& nominal() const { return nominal_; }
@@ -280,6 +289,7 @@ class WithEffects {
       for (int j = 0; j < W; ++j) throttle[j] = esc_throttle(throttle[j], motor_rim_speed<W>(x, j));
     }
     body_accelerations<W>(x, steer, ax, ay, yaw_accel);
+    declared_body_accelerations<W>(x, steer, ax, ay, yaw_accel, dt_s);
     other_grip_weights<W>(x, other_w);
     int before_lanes = 0, blended_lanes = 0;
     for (int j = 0; j < W; ++j) {
@@ -373,6 +383,20 @@ class WithEffects {
       MPPI_SIMD_LOOP
       for (int j = 0; j < W; ++j) add_rolling_resistance(x, j, steer[j], &ax[j], &ay[j], &yaw_accel[j]);
     }
+  }
+  // The declared effects' terms (dynamics/effects/effect_registry.hpp), each on its own states.
+  template <int W>
+  void declared_body_accelerations(Batch<kNx, W> x, const float* steer, float* ax, float* ay, float* yaw_accel,
+                                   float dt_s) const noexcept {
+    const BodyAccelLanes<W> lanes{x[state::kVx], x[state::kVy], x[state::kYawRate], steer, ax, ay, yaw_accel};
+    for_each_type(effects::DeclaredEffects{}, [&]<class E>() {
+      const auto& term = std::get<typename E::Term>(declared_);
+      if (!term.active()) return;
+      float* rows[E::kStates];
+      for (int i = 0; i < E::kStates; ++i)
+        rows[i] = x[kDeclaredStates + effects::StateOffset<E, effects::DeclaredEffects>::kValue + i];
+      term.template add_body_accelerations<W>(lanes, rows, dt_s);
+    });
   }
   // Rolling resistance F0 tanh(v / 0.5) + b v against each axle's rolling speed v, along its
   // wheel: the rear along the body's x axis, the front turned by the wheel angle delta, so that
@@ -469,6 +493,13 @@ class WithEffects {
   float loop_top_speed_mps_ = 0, loop_gain_per_mps_ = 0, loop_integral_gain_per_m_ = 0, loop_feedforward_per_mps_ = 0;
   float freewheel_per_mps_ = 0, drag_brake_cmd_ = 0, brake_ratio_ = 1, inv_brake_ratio_ = 1, wheel_radius_ = 1;
   float front_drive_ = 0;  // the base's share of the drive on the front axle (after the effects)
+  template <class List>
+  struct TermsOf;
+  template <class... E>
+  struct TermsOf<TypeList<E...>> {
+    using type = std::tuple<typename E::Term...>;
+  };
+  typename TermsOf<effects::DeclaredEffects>::type declared_;  // the declared effects' physics
 };
 
 using CorrectedSingleTrack = WithEffects<SingleTrack>;

@@ -77,7 +77,7 @@ std::vector<double> naive_predict(const ReplayModel& m, const DiagData& d, const
 }
 
 // Segments of 25 rows: every 7th row (overlapping), so that runs of lanes, their remainders and
-// the starts just after the piece boundary (short histories, groups of one or two) all occur.
+// the starts just after the piece boundary (short histories: lanes that join their group late) all occur.
 std::vector<Segment> segments_of(const DiagData& d) {
   std::vector<Segment> segs;
   for (std::size_t k = 0; k + 26 < d.rows(); k += 7)
