@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 
 #include "base/error.hpp"
+#include "base/least_squares.hpp"
 
 namespace mppi::diagnose {
 
@@ -204,79 +205,48 @@ double mean_cost(const FitProblem& p, const EffectParams& e) {
 FitResult fit_params(const FitProblem& p, const EffectParams& base, const std::vector<ParamSpec>& free,
                      int max_iterations) {
   const int np = static_cast<int>(free.size());
-  FitResult res;
-  res.effects = base;
   auto with = [&](const Eigen::VectorXd& v) {
     EffectParams e = base;
     for (int i = 0; i < np; ++i) e.*(free[static_cast<std::size_t>(i)].member) = v[i];
     return e;
   };
-  Eigen::VectorXd v(np);
-  for (int i = 0; i < np; ++i) v[i] = base.*(free[static_cast<std::size_t>(i)].member);
-  std::vector<double> r0, r1;
-  double c0 = residuals(p, with(v), &r0);
-  double mu = 1e-3;
-  const std::size_t n = r0.size();
-  Eigen::MatrixXd J(static_cast<Eigen::Index>(n), np);
-  // J <- d residuals / d parameters at u (r0 = residuals at u): forward differences, stepping
-  // inwards at the upper bounds.
-  auto jacobian_at = [&](const Eigen::VectorXd& u) {
-    for (int i = 0; i < np; ++i) {
-      const ParamSpec& s = free[static_cast<std::size_t>(i)];
-      double h = 0.01 * s.scale;
-      if (u[i] + h > s.hi) h = -h;
-      Eigen::VectorXd up = u;
-      up[i] += h;
-      residuals(p, with(up), &r1);
-      if (r1.size() != n) r1.assign(n, 0.0);
-      for (std::size_t k = 0; k < n; ++k) J(static_cast<Eigen::Index>(k), i) = (r1[k] - r0[k]) / h;
-    }
-  };
-  for (int it = 0; it < max_iterations && np > 0 && std::isfinite(c0) && n > 0; ++it) {
-    res.iterations = it + 1;
-    jacobian_at(v);
-    const Eigen::Map<const Eigen::VectorXd> rv(r0.data(), static_cast<Eigen::Index>(n));
-    // lazyProduct: a few parameters against thousands of residuals is a handful of dot products;
-    // Eigen's GEMM would open an OpenMP team inside each parallel candidate fit.
-    const Eigen::MatrixXd A = J.transpose().lazyProduct(J);
-    const Eigen::VectorXd g = J.transpose() * rv;
-    bool improved = false;
-    for (int tries = 0; tries < 8; ++tries) {
-      Eigen::MatrixXd Am = A;
-      for (int i = 0; i < np; ++i) Am(i, i) += mu * std::max(A(i, i), 1e-12);
-      Eigen::VectorXd step = Am.ldlt().solve(-g);
-      Eigen::VectorXd vn = v + step;
-      for (int i = 0; i < np; ++i)
-        vn[i] = std::clamp(vn[i], free[static_cast<std::size_t>(i)].lo, free[static_cast<std::size_t>(i)].hi);
-      const double c1 = residuals(p, with(vn), &r1);
-      if (std::isfinite(c1) && c1 < c0 && r1.size() == n) {
-        const double rel = (c0 - c1) / c0;
-        v = vn;
-        r0.swap(r1);
-        c0 = c1;
-        mu = std::max(mu / 3, 1e-7);
-        improved = true;
-        if (rel < 1e-5) it = max_iterations;  // converged
-        break;
-      }
-      mu *= 4;
-    }
-    if (!improved) break;
+  LeastSquaresProblem problem;
+  problem.residuals = [&](const Eigen::VectorXd& v, std::vector<double>* r) { return residuals(p, with(v), r); };
+  problem.lower.resize(np);
+  problem.upper.resize(np);
+  problem.difference_step.resize(np);
+  Eigen::VectorXd start(np);
+  for (int i = 0; i < np; ++i) {
+    const ParamSpec& s = free[static_cast<std::size_t>(i)];
+    problem.lower[i] = s.lo;
+    problem.upper[i] = s.hi;
+    problem.difference_step[i] = 0.01 * s.scale;
+    start[i] = base.*(s.member);
   }
-  res.cost = c0;
-  res.effects = with(v);
+  LevenbergMarquardtOptions options;
+  options.max_iterations = max_iterations;
+  options.tries_per_iteration = 8;
+  options.initial_damping = 1e-3;
+  options.damping_down = 3.0;
+  options.min_damping = 1e-7;
+  options.damping_up = 4.0;
+  options.relative_tolerance = 1e-5;
+  const LeastSquaresResult fit = levenberg_marquardt(problem, start, options);
+  FitResult res;
+  res.iterations = fit.iterations;
+  res.cost = fit.cost;
+  res.effects = with(fit.params);
   // Uncertainty: s^2 (J^T J)^-1 at the optimum, s^2 inflated by the residual correlation of
   // multi-step predictions (about one independent sample in five).
+  const std::size_t n = fit.residuals.size();
   Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(np, np);
-  if (np > 0 && n > static_cast<std::size_t>(np) && std::isfinite(c0)) {
-    jacobian_at(v);
-    const double s2 = c0 * static_cast<double>(n) / static_cast<double>(n - static_cast<std::size_t>(np)) * 5.0;
-    const Eigen::MatrixXd A = J.transpose().lazyProduct(J);
-    cov = A.completeOrthogonalDecomposition().pseudoInverse() * s2;
+  if (np > 0 && n > static_cast<std::size_t>(np) && std::isfinite(fit.cost)) {
+    const double s2 = fit.cost * static_cast<double>(n) / static_cast<double>(n - static_cast<std::size_t>(np)) * 5.0;
+    cov = normal_matrix_at(problem, fit).completeOrthogonalDecomposition().pseudoInverse() * s2;
   }
   for (int i = 0; i < np; ++i) {
     const ParamSpec& s = free[static_cast<std::size_t>(i)];
-    res.params.push_back({s.name, s.unit, v[i], std::sqrt(std::max(0.0, cov(i, i)))});
+    res.params.push_back({s.name, s.unit, fit.params[i], std::sqrt(std::max(0.0, cov(i, i)))});
   }
   return res;
 }

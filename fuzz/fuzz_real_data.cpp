@@ -1,4 +1,4 @@
-// Converters of the real recordings (sysid/real_data.cpp): DART JetRacer (14 and 10 columns)
+// Converters of the real recordings (sysid/real_converters.cpp): DART JetRacer (14 and 10 columns)
 // and ETH RC car CSV files, recognised by their header row.
 #include "fuzz/fuzz_input.hpp"
 #include "sysid/real_data.hpp"

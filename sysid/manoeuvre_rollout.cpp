@@ -5,6 +5,7 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "base/error.hpp"
 #include "mppi/vehicle_state.hpp"
@@ -35,6 +36,76 @@ Piece draw_piece(int manoeuvre, std::mt19937_64& rng) {
     default: p.target_mps = in(8, 10); p.amplitude = in(0.08, 0.2); p.period_s = in(3, 7); break;
   }
   return p;
+}
+
+// The pattern's steer and throttle at `tin` into the piece, before the noise, with the recovery
+// from a spin or slide taking over where the car left the regime of the data.
+struct Command {
+  double steer = 0, throttle = 0;
+};
+
+Command manoeuvre_command(const Piece& piece, double tin, const std::vector<double>& x, const ManoeuvreOptions& o) {
+  const double vx = x[state::kVx], r = x[state::kYawRate];
+  auto hold = [&](double target) {
+    return o.ff_offset + o.ff_per_mps * target + o.speed_gain_per_mps * (target - vx);
+  };
+  double steer = 0, throttle = 0;
+  switch (piece.manoeuvre) {
+    case 1:  // low speed, normal driving
+      throttle = hold(piece.target_mps + std::sin(kTwoPi * tin / 3.7));
+      steer = piece.side * piece.amplitude * std::sin(kTwoPi * tin / piece.period_s);
+      break;
+    case 2:  // zig-zag
+      throttle = hold(piece.target_mps);
+      steer = piece.side * piece.amplitude * std::tanh(3 * std::sin(kTwoPi * tin / piece.period_s));
+      break;
+    case 3:  // accelerate hard, then brake to about 4 m/s, heading held by yaw-rate feedback
+      if (tin < 0.4 * o.piece_duration_s && vx < piece.target_mps) throttle = o.max_throttle;
+      else if (vx > 4.0) throttle = piece.brake;
+      else throttle = hold(5.0);
+      steer = -0.3 * r;
+      break;
+    case 4:  // sliding: approach, power slide at (near) full lock, countersteer, recover
+      if (tin < 0.3 * o.piece_duration_s) {
+        throttle = hold(piece.target_mps);
+        steer = 0.1 * piece.side;
+      } else if (tin < 0.55 * o.piece_duration_s) {
+        throttle = o.max_throttle;
+        steer = piece.side * piece.amplitude;
+      } else if (tin < 0.7 * o.piece_duration_s) {
+        throttle = 0.3;
+        steer = -0.4 * piece.side;
+      } else {
+        throttle = hold(5.0);
+        steer = -0.3 * r;
+      }
+      break;
+    default:  // high speed, wide curves
+      throttle = hold(piece.target_mps);
+      steer = piece.side * piece.amplitude * std::sin(kTwoPi * tin / piece.period_s);
+      break;
+  }
+  // Recovery, as a driver catches a spin: countersteer on the yaw rate and hold a moderate
+  // speed while the car is outside the regime of the data (spinning, sliding far, too slow).
+  if (std::abs(r) > o.recover_yaw_rate_radps || std::abs(x[state::kVy]) > o.recover_lateral_mps ||
+      vx < o.recover_below_mps) {
+    steer = std::clamp(-0.3 * r, -0.6, 0.6);
+    throttle = hold(5.0);
+  }
+  return {steer, throttle};
+}
+
+// An empty recording of the rollout's columns: the required ones, roll, segment, then the extras.
+sim::Recording rollout_recording(std::size_t state_size, const ManoeuvreOptions& o) {
+  sim::Recording rec;
+  rec.columns.assign(sim::kRecordingRequiredColumns.begin(), sim::kRecordingRequiredColumns.end());
+  rec.columns.insert(rec.columns.end(), {"roll", "segment"});
+  if (state_size < static_cast<std::size_t>(state::kCommonStates) + o.extra_state_columns.size())
+    throw Error("manoeuvre rollout: more extra_state_columns than model states after the common 7");
+  rec.columns.insert(rec.columns.end(), o.extra_state_columns.begin(), o.extra_state_columns.end());
+  rec.data.resize(rec.columns.size());
+  rec.metadata["source"] = "scripted manoeuvres (sysid/manoeuvre_rollout.cpp), seed " + std::to_string(o.seed);
+  return rec;
 }
 
 }  // namespace
@@ -68,14 +139,7 @@ sim::Recording roll_out_manoeuvres(const RolloutStep& step, std::vector<double> 
   std::mt19937_64 dither_rng(o.seed ^ 0x9e3779b97f4a7c15ULL);
   std::normal_distribution<double> dither_gauss(0.0, 1.0);
 
-  sim::Recording rec;
-  rec.columns.assign(sim::kRecordingRequiredColumns.begin(), sim::kRecordingRequiredColumns.end());
-  rec.columns.insert(rec.columns.end(), {"roll", "segment"});
-  if (x.size() < static_cast<std::size_t>(state::kCommonStates) + o.extra_state_columns.size())
-    throw Error("manoeuvre rollout: more extra_state_columns than model states after the common 7");
-  rec.columns.insert(rec.columns.end(), o.extra_state_columns.begin(), o.extra_state_columns.end());
-  rec.data.resize(rec.columns.size());
-  rec.metadata["source"] = "scripted manoeuvres (sysid/manoeuvre_rollout.cpp), seed " + std::to_string(o.seed);
+  sim::Recording rec = rollout_recording(x.size(), o);
 
   const long samples = std::lround(o.duration_s / o.sample_dt_s);
   const long per_piece = std::max(1L, std::lround(o.piece_duration_s / o.sample_dt_s));
@@ -86,53 +150,7 @@ sim::Recording roll_out_manoeuvres(const RolloutStep& step, std::vector<double> 
   for (long i = 0; i < samples; ++i) {
     if (i % per_piece == 0) piece = draw_piece(static_cast<int>((i / per_piece) % 5) + 1, rng);
     const double tin = static_cast<double>(i % per_piece) * o.sample_dt_s;  // time in the piece
-    const double vx = x[state::kVx], r = x[state::kYawRate];
-    auto hold = [&](double target) {
-      return o.ff_offset + o.ff_per_mps * target + o.speed_gain_per_mps * (target - vx);
-    };
-    double steer = 0, throttle = 0;
-    switch (piece.manoeuvre) {
-      case 1:  // low speed, normal driving
-        throttle = hold(piece.target_mps + std::sin(kTwoPi * tin / 3.7));
-        steer = piece.side * piece.amplitude * std::sin(kTwoPi * tin / piece.period_s);
-        break;
-      case 2:  // zig-zag
-        throttle = hold(piece.target_mps);
-        steer = piece.side * piece.amplitude * std::tanh(3 * std::sin(kTwoPi * tin / piece.period_s));
-        break;
-      case 3:  // accelerate hard, then brake to about 4 m/s, heading held by yaw-rate feedback
-        if (tin < 0.4 * o.piece_duration_s && vx < piece.target_mps) throttle = o.max_throttle;
-        else if (vx > 4.0) throttle = piece.brake;
-        else throttle = hold(5.0);
-        steer = -0.3 * r;
-        break;
-      case 4:  // sliding: approach, power slide at (near) full lock, countersteer, recover
-        if (tin < 0.3 * o.piece_duration_s) {
-          throttle = hold(piece.target_mps);
-          steer = 0.1 * piece.side;
-        } else if (tin < 0.55 * o.piece_duration_s) {
-          throttle = o.max_throttle;
-          steer = piece.side * piece.amplitude;
-        } else if (tin < 0.7 * o.piece_duration_s) {
-          throttle = 0.3;
-          steer = -0.4 * piece.side;
-        } else {
-          throttle = hold(5.0);
-          steer = -0.3 * r;
-        }
-        break;
-      default:  // high speed, wide curves
-        throttle = hold(piece.target_mps);
-        steer = piece.side * piece.amplitude * std::sin(kTwoPi * tin / piece.period_s);
-        break;
-    }
-    // Recovery, as a driver catches a spin: countersteer on the yaw rate and hold a moderate
-    // speed while the car is outside the regime of the data (spinning, sliding far, too slow).
-    if (std::abs(r) > o.recover_yaw_rate_radps || std::abs(x[state::kVy]) > o.recover_lateral_mps ||
-        vx < o.recover_below_mps) {
-      steer = std::clamp(-0.3 * r, -0.6, 0.6);
-      throttle = hold(5.0);
-    }
+    const auto [steer, throttle] = manoeuvre_command(piece, tin, x, o);
     steer_noise = a * steer_noise + b * 0.08 * gauss(rng);
     throttle_noise = a * throttle_noise + b * 0.05 * gauss(rng);
     const double steer_dither = o.steer_dither_std * dither_gauss(dither_rng);

@@ -4,10 +4,12 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include <Eigen/Dense>
 
 #include "base/error.hpp"
+#include "base/least_squares.hpp"
 #include "sysid/real_data.hpp"
 
 namespace mppi::sysid {
@@ -251,44 +253,69 @@ sim::Recording read_learned_model_log(const std::string& path) {
   return rec;
 }
 
-std::vector<double> step_response(const RolloutStep& step, std::vector<double> x, const double u[2],
-                                  std::size_t channel, const std::vector<double>& leads_s, double dt_s) {
-  if (!(dt_s > 0) || leads_s.empty() || channel >= x.size())
-    throw Error("step response: dt_s > 0, at least one lead and a channel of the state are needed");
-  std::vector<double> out;
-  double t = 0;
-  for (double lead : leads_s) {
-    for (; t < lead - 0.5 * dt_s; t += dt_s) step(x, u, dt_s);
-    out.push_back(x[channel]);
-  }
-  return out;
+namespace {
+
+// The box of parameter `i` in physical units (CalibrationOptions documents the defaults).
+std::pair<double, double> physical_bounds(const VehicleModelSpec& spec, const CalibrationOptions& o, std::size_t i) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const std::string& n = spec.estimated[i];
+  if (!o.bounds.empty()) return o.bounds[i];
+  if (spec.log_scale[i]) return {spec.nominal[i] / o.log_range, spec.nominal[i] * o.log_range};
+  if (n == "tyre.C") return {0.05, 1.99};
+  if (n == "tyre.E") return {-10, 0.99};
+  if (n == "rear_tyre_C_scale") return {0.3, 1.6};  // keeps the rear C inside (0, 2) for front C up to 1.2
+  if (n == "rear_tyre_B_scale" || n == "rear_tyre_D_scale") return {0.3, 3.0};
+  if (n == "steer_lag_s" || n == "throttle_lag_s") return {0, 0.5};
+  if (n == "steer_cubic") return {-0.9, 1.9};
+  if (n == "steer_offset") return {-0.3, 0.3};
+  return {-kInf, kInf};
 }
 
-std::vector<double> steering_step_yaw_rate(const VehicleModelSpec& spec, const std::vector<double>& values,
-                                           double speed_mps, double steer, double throttle,
-                                           const std::vector<double>& leads_s, double dt_s) {
-  if (!(dt_s > 0)) throw Error("steering step: dt_s must be > 0");
-  // 1 s of straight driving, then the step: a recording to start (and prime) the plant from.
-  const int before = static_cast<int>(std::lround(1.0 / dt_s));
-  sim::Recording rec;
-  rec.columns = {"t", "x", "y", "yaw", "vx", "vy", "yaw_rate", "steer", "throttle"};
-  rec.data.assign(rec.columns.size(), {});
-  for (int i = 0; i <= before; ++i) {
-    const double row[9] = {i * dt_s, 0, 0, 0, speed_mps, 0, 0, i < before ? 0.0 : steer, throttle};
-    for (std::size_t c = 0; c < 9; ++c) rec.data[c].push_back(row[c]);
-  }
-  std::vector<double> x(static_cast<std::size_t>(spec.nx));
-  spec.init_state(rec, static_cast<std::size_t>(before), x.data());
-  if (spec.prime) spec.prime(values, rec, static_cast<std::size_t>(before), x.data());
-  const auto m = std::find_if(spec.measurable.begin(), spec.measurable.end(),
-                              [](const auto& c) { return c.first == "yaw_rate"; });
-  if (m == spec.measurable.end()) throw Error("steering step: the " + spec.kind + " model has no yaw rate");
-  const RolloutStep plant = [&](std::vector<double>& s, const double u[2], double dt) {
-    spec.step(values, s.data(), u, dt);
-  };
-  const double u[2] = {steer, throttle};
-  return step_response(plant, std::move(x), u, static_cast<std::size_t>(m->second), leads_s, dt_s);
+// The search space: z = log(p) for positive parameters, z = p otherwise.
+double to_search(const VehicleModelSpec& spec, std::size_t i, double value) {
+  return spec.log_scale[i] ? std::log(value) : value;
 }
+std::vector<double> to_values(const VehicleModelSpec& spec, const Eigen::VectorXd& z) {
+  std::vector<double> v(spec.estimated.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const double zi = z[static_cast<Eigen::Index>(i)];
+    v[i] = spec.log_scale[i] ? std::exp(zi) : zi;
+  }
+  return v;
+}
+
+// The box in the search space, into `problem`.
+void set_search_box(const VehicleModelSpec& spec, const CalibrationOptions& o, LeastSquaresProblem& problem) {
+  const std::size_t np = spec.estimated.size();
+  problem.lower.resize(static_cast<Eigen::Index>(np));
+  problem.upper.resize(static_cast<Eigen::Index>(np));
+  for (std::size_t i = 0; i < np; ++i) {
+    const auto [lo, hi] = physical_bounds(spec, o, i);
+    if (spec.log_scale[i] && !(lo > 0))
+      throw Error("calibrate: the lower bound of " + spec.estimated[i] + " must be > 0");
+    problem.lower[static_cast<Eigen::Index>(i)] = to_search(spec, i, lo);
+    problem.upper[static_cast<Eigen::Index>(i)] = to_search(spec, i, hi);
+  }
+}
+
+// The start in the search space, inside the box. A lag of 0 has no derivative (a forward step of
+// 1e-4 s is far below the 2-ms substep): lags that would begin at 0 start at 0.05 s.
+Eigen::VectorXd search_start(const VehicleModelSpec& spec, const LeastSquaresProblem& problem,
+                             std::vector<double>& initial) {
+  const std::size_t np = spec.estimated.size();
+  for (std::size_t i = 0; i < np; ++i)
+    if ((spec.estimated[i] == "steer_lag_s" || spec.estimated[i] == "throttle_lag_s") && initial[i] == 0)
+      initial[i] = 0.05;
+  Eigen::VectorXd z(static_cast<Eigen::Index>(np));
+  for (std::size_t i = 0; i < np; ++i) {
+    if (spec.log_scale[i] && !(initial[i] > 0)) throw Error("calibrate: " + spec.estimated[i] + " must start > 0");
+    const auto k = static_cast<Eigen::Index>(i);
+    z[k] = std::clamp(to_search(spec, i, initial[i]), problem.lower[k], problem.upper[k]);
+  }
+  return z;
+}
+
+}  // namespace
 
 CalibrationResult calibrate(const VehicleModelSpec& spec, const sim::Recording& rec, const std::vector<double>& scales,
                             const CalibrationOptions& o, std::vector<double> initial) {
@@ -301,120 +328,42 @@ CalibrationResult calibrate(const VehicleModelSpec& spec, const sim::Recording& 
   const RolloutPlan plan = make_plan(spec, rec, o.error);
   if (scales.size() != plan.state_index.size()) throw Error("calibrate: one scale per channel is needed");
 
-  // Search space: z = log(p) for positive parameters, z = p otherwise; box in z.
-  std::vector<double> lo(np), hi(np);
-  for (std::size_t i = 0; i < np; ++i) {
-    const std::string& n = spec.estimated[i];
-    if (!o.bounds.empty()) {
-      lo[i] = o.bounds[i].first;
-      hi[i] = o.bounds[i].second;
-    } else if (spec.log_scale[i]) {
-      lo[i] = spec.nominal[i] / o.log_range;
-      hi[i] = spec.nominal[i] * o.log_range;
-    } else if (n == "tyre.C") {
-      lo[i] = 0.05, hi[i] = 1.99;
-    } else if (n == "tyre.E") {
-      lo[i] = -10, hi[i] = 0.99;
-    } else if (n == "rear_tyre_C_scale") {  // keeps the rear C inside (0, 2) for front C up to 1.2
-      lo[i] = 0.3, hi[i] = 1.6;
-    } else if (n == "rear_tyre_B_scale" || n == "rear_tyre_D_scale") {
-      lo[i] = 0.3, hi[i] = 3.0;
-    } else if (n == "steer_lag_s" || n == "throttle_lag_s") {
-      lo[i] = 0, hi[i] = 0.5;
-    } else if (n == "steer_cubic") {
-      lo[i] = -0.9, hi[i] = 1.9;
-    } else if (n == "steer_offset") {
-      lo[i] = -0.3, hi[i] = 0.3;
-    } else {
-      lo[i] = -std::numeric_limits<double>::infinity(), hi[i] = std::numeric_limits<double>::infinity();
-    }
-    if (spec.log_scale[i]) {
-      if (!(lo[i] > 0)) throw Error("calibrate: the lower bound of " + n + " must be > 0");
-      lo[i] = std::log(lo[i]);
-      hi[i] = std::log(hi[i]);
-    }
-  }
-  auto to_values = [&](const Eigen::VectorXd& z) {
-    std::vector<double> v(np);
-    for (std::size_t i = 0; i < np; ++i) v[i] = spec.log_scale[i] ? std::exp(z[static_cast<Eigen::Index>(i)]) : z[static_cast<Eigen::Index>(i)];
-    return v;
+  LeastSquaresProblem problem;
+  set_search_box(spec, o, problem);
+  problem.difference_step = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(np), 1e-4);
+  problem.step_scales_with_value = true;
+  // Residuals that were not recorded (NaN) do not count: zeroed for the least squares.
+  problem.residuals = [&](const Eigen::VectorXd& z, std::vector<double>* out) {
+    residuals(spec, to_values(spec, z), rec, plan, scales, *out);
+    const double cost = mean_square(*out);
+    for (double& v : *out)
+      if (!std::isfinite(v)) v = 0;
+    return cost;
   };
-  auto project = [&](Eigen::VectorXd& z) {
-    for (std::size_t i = 0; i < np; ++i) z[static_cast<Eigen::Index>(i)] = std::clamp(z[static_cast<Eigen::Index>(i)], lo[i], hi[i]);
-  };
-  // A lag of 0 has no derivative (a forward step of 1e-4 s is far below the 2-ms substep): start
-  // lags that would begin at 0 at 0.05 s.
-  for (std::size_t i = 0; i < np; ++i)
-    if ((spec.estimated[i] == "steer_lag_s" || spec.estimated[i] == "throttle_lag_s") && initial[i] == 0)
-      initial[i] = 0.05;
-  Eigen::VectorXd z(static_cast<Eigen::Index>(np));
-  for (std::size_t i = 0; i < np; ++i) {
-    if (spec.log_scale[i] && !(initial[i] > 0)) throw Error("calibrate: " + spec.estimated[i] + " must start > 0");
-    z[static_cast<Eigen::Index>(i)] = spec.log_scale[i] ? std::log(initial[i]) : initial[i];
-  }
-  project(z);
+  const Eigen::VectorXd start = search_start(spec, problem, initial);
+  LevenbergMarquardtOptions lm;
+  lm.max_iterations = o.max_iterations;
+  lm.tries_per_iteration = 12;
+  lm.initial_damping = 1e-3;
+  lm.damping_down = 3.0;
+  lm.min_damping = 1e-9;
+  lm.damping_up = 10.0;
+  lm.relative_tolerance = o.relative_tolerance;
+  const LeastSquaresResult fit = levenberg_marquardt(problem, start, lm);
 
   CalibrationResult res;
   res.names = spec.estimated;
   res.initial = initial;
-  std::vector<double> r, r2;
-  // Residuals that were not recorded (NaN) do not count: zero them for the least squares.
-  auto eval = [&](const Eigen::VectorXd& zz, std::vector<double>& out) {
-    residuals(spec, to_values(zz), rec, plan, scales, out);
-    ++res.evaluations;
-    const double c = mean_square(out);
-    for (double& v : out)
-      if (!std::isfinite(v)) v = 0;
-    return c;
-  };
-  double cost = eval(z, r);
-  res.cost_history.push_back(cost);
-  const Eigen::Index m = static_cast<Eigen::Index>(r.size());
-  Eigen::MatrixXd J(m, static_cast<Eigen::Index>(np));
-  double lambda = 1e-3;
-  for (int it = 0; it < o.max_iterations; ++it) {
-    for (std::size_t j = 0; j < np; ++j) {
-      const Eigen::Index jj = static_cast<Eigen::Index>(j);
-      Eigen::VectorXd zp = z;
-      double h = 1e-4 * std::max(1.0, std::abs(z[jj]));
-      if (zp[jj] + h > hi[j]) h = -h;  // stay inside the box
-      zp[jj] += h;
-      eval(zp, r2);
-      for (Eigen::Index k = 0; k < m; ++k) J(k, jj) = (r2[static_cast<std::size_t>(k)] - r[static_cast<std::size_t>(k)]) / h;
-    }
-    const Eigen::Map<const Eigen::VectorXd> rv(r.data(), m);
-    const Eigen::MatrixXd JtJ = J.transpose() * J;
-    const Eigen::VectorXd g = J.transpose() * rv;
-    bool improved = false;
-    for (int tries = 0; tries < 12 && !improved; ++tries) {
-      Eigen::MatrixXd A = JtJ;
-      for (Eigen::Index d = 0; d < A.rows(); ++d) A(d, d) += lambda * std::max(JtJ(d, d), 1e-12);
-      Eigen::VectorXd zn = z - A.ldlt().solve(g);
-      project(zn);
-      const double cn = eval(zn, r2);
-      if (std::isfinite(cn) && cn < cost) {
-        const double rel = (cost - cn) / cost;
-        z = zn;
-        r.swap(r2);
-        cost = cn;
-        lambda = std::max(lambda / 3, 1e-9);
-        improved = true;
-        res.cost_history.push_back(cost);
-        if (rel < o.relative_tolerance) it = o.max_iterations;  // converged
-      } else {
-        lambda *= 10;
-      }
-    }
-    res.iterations = it + 1;
-    if (!improved) break;
-  }
-  res.values = to_values(z);
+  res.values = to_values(spec, fit.params);
+  res.cost_history = fit.cost_history;
+  res.iterations = fit.iterations;
+  res.evaluations = fit.evaluations;
   res.at_bound.resize(np);
   for (std::size_t i = 0; i < np; ++i) {
-    const double zi = z[static_cast<Eigen::Index>(i)];
-    res.at_bound[i] = std::abs(zi - lo[i]) < 1e-9 || std::abs(zi - hi[i]) < 1e-9;
+    const auto k = static_cast<Eigen::Index>(i);
+    const double z = fit.params[k];
+    res.at_bound[i] = std::abs(z - problem.lower[k]) < 1e-9 || std::abs(z - problem.upper[k]) < 1e-9;
   }
-  res.iterations = std::min(res.iterations, o.max_iterations);
   return res;
 }
 

@@ -5,7 +5,7 @@
 // velocities and yaw rate by default), each divided by the channel's standard deviation in
 // the recording (normalised RMSE). The fit is Levenberg-Marquardt with a forward-difference
 // Jacobian over the parameters a VehicleModelSpec exposes (positive ones in log space), kept
-// inside a box. docs/CALIBRATION.md.
+// inside a box (base/least_squares.hpp). docs/CALIBRATION.md.
 #include <string>
 #include <utility>
 #include <vector>

@@ -165,6 +165,58 @@ std::string num(double v) {
   return buf;
 }
 
+// The metadata every recording of the run carries: source, timing, segments, layout, noise.
+std::map<std::string, std::string> protocol_metadata(const ProtocolOptions& o) {
+  return {
+      {"source", "mppi sysid protocol (simulated AutoRally full vehicle, sysid/protocol.cpp)"},
+      {"model", mppi::models::FullVehicleModel::kName},
+      {"truth_parameters", "truth.yaml"},
+      {"seed", std::to_string(o.seed)},
+      {"sample_rate_hz", num(o.sample_rate_hz)},
+      {"plant_dt_s", num(o.plant_dt_s)},
+      {"command_timing", "steer, throttle are held from this row's t to the next row's t"},
+      {"segments", "1 low_speed, 2 zig_zag, 3 accelerate_brake, 4 sliding, 5 high_speed (" +
+                       num(o.manoeuvre_duration_s) + " s each), 6 validation (" +
+                       num(o.validation_duration_s) + " s)"},
+      {"layout", o.layout == ProtocolLayout::sequential
+                     ? std::string("sequential (each manoeuvre in turn)")
+                     : "interleaved (cycles of five " + num(o.piece_duration_s) + " s pieces, one per manoeuvre)"},
+      {"noise_std", "position " + num(o.position_noise_m) + " m, yaw " + num(o.yaw_noise_rad) +
+                        " rad, velocity " + num(o.velocity_noise_mps) + " m/s, rates " +
+                        num(o.rate_noise_radps) + " rad/s, roll/pitch " + num(o.angle_noise_rad) +
+                        " rad, accel " + num(o.accel_noise_mps2) + " m/s^2, wheels " +
+                        num(o.wheel_noise_radps) + " rad/s"}};
+}
+
+// A row of the measured recording: the true state `x` with noise drawn by `noisy` (in the order of
+// the columns), the commands, the accelerations, the wheel speeds and the segment.
+template <class Noisy>
+std::vector<double> measured_row(double t, const double* x, const Control& u, double ax, double ay, int seg,
+                                 double radius, const ProtocolOptions& o, Noisy& noisy) {
+  const double w[4] = {noisy(x[7], o.wheel_noise_radps), noisy(x[8], o.wheel_noise_radps),
+                       noisy(x[9], o.wheel_noise_radps), noisy(x[10], o.wheel_noise_radps)};
+  return {
+      t,
+      noisy(x[state::kX], o.position_noise_m),
+      noisy(x[state::kY], o.position_noise_m),
+      noisy(x[state::kYaw], o.yaw_noise_rad),
+      noisy(x[state::kVx], o.velocity_noise_mps),
+      noisy(x[state::kVy], o.velocity_noise_mps),
+      noisy(x[state::kYawRate], o.rate_noise_radps),
+      u.steer,
+      u.throttle,
+      noisy(x[state::kRoll], o.angle_noise_rad),
+      noisy(x[FullVehicle::kPitch], o.angle_noise_rad),
+      noisy(x[FullVehicle::kRollRate], o.rate_noise_radps),
+      noisy(x[FullVehicle::kPitchRate], o.rate_noise_radps),
+      noisy(x[FullVehicle::kHeaveRate], o.velocity_noise_mps),
+      noisy(ax, o.accel_noise_mps2),
+      noisy(ay, o.accel_noise_mps2),
+      radius * 0.25 * (w[0] + w[1] + w[2] + w[3]),
+      w[0], w[1], w[2], w[3],
+      static_cast<double>(seg)};
+}
+
 }  // namespace
 
 bool ProtocolOptions::is_valid(std::string* why) const {
@@ -238,25 +290,7 @@ ProtocolRun run_protocol(const FullVehicleParams& params, const ProtocolOptions&
   const long n_train = std::lround(5 * o.manoeuvre_duration_s * o.sample_rate_hz);
   const long n_val = std::lround(o.validation_duration_s * o.sample_rate_hz);
 
-  std::map<std::string, std::string> meta = {
-      {"source", "mppi sysid protocol (simulated AutoRally full vehicle, sysid/protocol.cpp)"},
-      {"model", mppi::models::FullVehicleModel::kName},
-      {"truth_parameters", "truth.yaml"},
-      {"seed", std::to_string(o.seed)},
-      {"sample_rate_hz", num(o.sample_rate_hz)},
-      {"plant_dt_s", num(o.plant_dt_s)},
-      {"command_timing", "steer, throttle are held from this row's t to the next row's t"},
-      {"segments", "1 low_speed, 2 zig_zag, 3 accelerate_brake, 4 sliding, 5 high_speed (" +
-                       num(o.manoeuvre_duration_s) + " s each), 6 validation (" +
-                       num(o.validation_duration_s) + " s)"},
-      {"layout", o.layout == ProtocolLayout::sequential
-                     ? std::string("sequential (each manoeuvre in turn)")
-                     : "interleaved (cycles of five " + num(o.piece_duration_s) + " s pieces, one per manoeuvre)"},
-      {"noise_std", "position " + num(o.position_noise_m) + " m, yaw " + num(o.yaw_noise_rad) +
-                        " rad, velocity " + num(o.velocity_noise_mps) + " m/s, rates " +
-                        num(o.rate_noise_radps) + " rad/s, roll/pitch " + num(o.angle_noise_rad) +
-                        " rad, accel " + num(o.accel_noise_mps2) + " m/s^2, wheels " +
-                        num(o.wheel_noise_radps) + " rad/s"}};
+  const std::map<std::string, std::string> meta = protocol_metadata(o);
   ProtocolRun run;
   run.training = empty_recording(kMeasuredExtras, meta);
   run.validation = empty_recording(kMeasuredExtras, meta);
@@ -289,28 +323,7 @@ ProtocolRun run_protocol(const FullVehicleParams& params, const ProtocolOptions&
     append(run.truth, {t, x[0], x[1], x[2], x[3], x[4], x[5], u.steer, u.throttle, x[6], x[7],
                        x[8], x[9], x[10], x[11], x[12], x[13], x[14], x[15], ax, ay,
                        static_cast<double>(seg)});
-    const double w[4] = {noisy(x[7], o.wheel_noise_radps), noisy(x[8], o.wheel_noise_radps),
-                         noisy(x[9], o.wheel_noise_radps), noisy(x[10], o.wheel_noise_radps)};
-    const std::vector<double> row = {
-        t,
-        noisy(x[state::kX], o.position_noise_m),
-        noisy(x[state::kY], o.position_noise_m),
-        noisy(x[state::kYaw], o.yaw_noise_rad),
-        noisy(x[state::kVx], o.velocity_noise_mps),
-        noisy(x[state::kVy], o.velocity_noise_mps),
-        noisy(x[state::kYawRate], o.rate_noise_radps),
-        u.steer,
-        u.throttle,
-        noisy(x[state::kRoll], o.angle_noise_rad),
-        noisy(x[FullVehicle::kPitch], o.angle_noise_rad),
-        noisy(x[FullVehicle::kRollRate], o.rate_noise_radps),
-        noisy(x[FullVehicle::kPitchRate], o.rate_noise_radps),
-        noisy(x[FullVehicle::kHeaveRate], o.velocity_noise_mps),
-        noisy(ax, o.accel_noise_mps2),
-        noisy(ay, o.accel_noise_mps2),
-        radius * 0.25 * (w[0] + w[1] + w[2] + w[3]),
-        w[0], w[1], w[2], w[3],
-        static_cast<double>(seg)};
+    const std::vector<double> row = measured_row(t, x, u, ax, ay, seg, radius, o, noisy);
     append(k < n_train ? run.training : run.validation, row);
 
     plant.advance(u, static_cast<float>(sample_dt));
