@@ -145,6 +145,7 @@ int cmd_diagnose(DiagnoseArgs& args) {
   for (const auto& s : r.selection.selected) std::printf(" %s", s.c_str());
   std::printf("%s\n", r.selection.selected.empty() ? " (none)" : "");
   std::printf("verdict: %s\n", r.selection.verdict.c_str());
+  std::printf("unexplained mismatch: %s\n", mppi::diagnose::unexplained_summary(r.unexplained).c_str());
   for (const auto& s : r.selection.suspected) std::printf("  suspected %s: %s\n", s.id.c_str(), s.reason.c_str());
   for (const auto& p : r.selection.final_params)
     std::printf("  %s = %.4g +- %.2g %s\n", p.name.c_str(), p.value, p.stddev, p.unit.c_str());

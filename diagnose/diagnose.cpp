@@ -94,6 +94,7 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
   // What is left: the corrected model's residuals, located on the held-out part.
   const ResidualSeries rs_after = residual_series(corrected, d, o.locate_horizon_s, o.replay);
   res.remaining = locate(d, rs_after, held);
+  res.unexplained = unexplained_mismatch(res.mismatch, res.remaining, o.unexplained);
 
   // 3. Model file.
   CorrectedModelFile file = nominal.file(res.selection.final_effects, res.selection.selected);

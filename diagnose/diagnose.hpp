@@ -9,6 +9,7 @@
 #include "diagnose/data.hpp"
 #include "diagnose/fit.hpp"
 #include "diagnose/locate.hpp"
+#include "diagnose/unexplained.hpp"
 #include "diagnose/model_comparison.hpp"
 #include "diagnose/model_family.hpp"
 #include "diagnose/replay.hpp"
@@ -26,6 +27,7 @@ struct DiagnoseOptions {
   // the located mismatch, nor out of the held-out judgement): control_loss.hpp.
   ControlLossOptions control_loss;
   ReplayOptions replay;
+  UnexplainedOptions unexplained;       // what of the remaining mismatch is reported unexplained
   bool plots = true;
   std::string params_source;            // nominal parameter file, for the report
   // Held-out recordings by name and time span (after concat): each gets its own before/after
@@ -54,6 +56,8 @@ struct DiagnoseResult {
   // residuals located on the held-out part, strongest first).
   double explained_share[kChannels] = {0, 0, 0};
   std::vector<Mismatch> remaining;
+  // Of those, what no named effect explains: clear and not a small remainder (unexplained.hpp).
+  std::vector<Mismatch> unexplained;
   // Per held-out recording (DiagnoseOptions::heldout_recordings): normalised RMSE at the
   // headline horizon, nominal and corrected.
   struct PartScore {

@@ -125,6 +125,11 @@ nlohmann::ordered_json report_json(const DiagData& d, const std::string& nominal
     left.push_back({{"channel", m.channel}, {"where", m.where}, {"magnitude", num(m.magnitude)},
                     {"rms", num(m.rms)}, {"z", num(m.z)}, {"unit", m.unit}});
   j["remaining"] = left;
+  json unexplained = json::array();
+  for (const auto& m : res.unexplained)
+    unexplained.push_back({{"channel", m.channel}, {"where", m.where}, {"magnitude", num(m.magnitude)},
+                           {"rms", num(m.rms)}, {"z", num(m.z)}, {"unit", m.unit}});
+  j["unexplained"] = unexplained;
   json parts = json::array();
   for (const auto& p : res.per_recording)
     parts.push_back({{"recording", p.name}, {"normalized_rmse_before", num(p.before)}, {"normalized_rmse_after", num(p.after)},

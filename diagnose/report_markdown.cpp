@@ -14,7 +14,9 @@ std::string report_markdown(const DiagData& d, const std::string& nominal_name, 
      << "- recording: `" << d.source << "` (" << d.rows() << " rows, dt " << d.dt_s << " s), held out: `" << o.holdout
      << "`\n- nominal model: " << nominal_name << (o.params_source.empty() ? " (library defaults)" : " from `" + o.params_source + "`")
      << "\n- corrected model: " << (res.model_file.empty() ? std::string("none written") : "`" + res.model_file + "`")
-     << "\n- verdict: **" << res.selection.verdict << "**\n";
+     << "\n- verdict: **" << res.selection.verdict << "**\n"
+     << "- unexplained mismatch (clear in the corrected model's held-out residual, no named effect explains it): "
+     << unexplained_summary(res.unexplained) << "\n";
   // The figure a user should trust first: on data that neither the fit nor the veto saw.
   if (o.test)
     md << "- **headline (test data, never seen by the fit or the validation):** normalised RMSE at "
