@@ -92,141 +92,166 @@ int history_rows(const DiagData& d, std::size_t k0, const ReplayOptions& o) {
 
 // Segments of one length replayed in lockstep: `lanes` = 1 (model.step) or ReplayModel::kLanes
 // (model.step_lanes; `count` <= kLanes real segments, the rest of the lanes repeat the first).
-// Lane j replays segs[j] after histories[j] rows of command history and writes its predictions to
-// outs[j]. The rows are counted back from the segments' starts, so every lane reaches its start
-// on the same row; a lane with a shorter history joins on its first row of history (until then
-// its state is stepped but not used). Lanes share each row's step: the mean of the sample
-// intervals of the lanes that have joined, so a recording with timing jitter advances a lane by
-// its own interval only on average.
-void predict_lockstep(const ReplayModel& model, const DiagData& d, const Segment* const* segs, double* const* outs,
-                      const int* histories, int count, int lanes, const ReplayOptions& o) {
-  constexpr int L = ReplayModel::kLanes;
-  const RecordingView view(model, d);
-  const int nx = model.states(), time_state = model.time_index(), len = segs[0]->len;
-  auto seg = [&](int j) -> const Segment& { return *segs[j < count ? j : 0]; };
-  auto history_of = [&](int j) { return histories[j < count ? j : 0]; };
-  const int history = *std::max_element(histories, histories + count);
-  auto joins_at = [&](int j) { return history - history_of(j); };  // the row a lane joins on
-  // The data row of lane j on row r (r = history: its segment's start).
-  auto data_row = [&](int j, int r) {
-    return static_cast<std::size_t>(static_cast<std::ptrdiff_t>(seg(j).start) + r - history);
-  };
-  // Unmeasured states (actuator chains, wheel speeds): run the model over the history before the
-  // start with its measured states forced back to the recording at every sample, so that they
-  // settle where this model puts them; then start from the measured state. The rows more than
-  // o.wheel_prime_s before the start run the actuator chains alone, one lane at a time.
-  const int wheel_rows = [&] {
-    int r = 0;
-    while (r < history && static_cast<double>(history - r) * d.dt_s > o.wheel_prime_s) ++r;
-    return r;
-  }();
-  alignas(64) float xs[ReplayModel::kMaxStates * L];
-  // Lane j's start state at its first row of history, its chains run over the chain-only rows.
-  auto start_lane = [&](int j) {
+// Lane j replays segs[j] after histories[j] rows of command history. The rows are counted back
+// from the segments' starts, so every lane reaches its start on the same row; a lane with a
+// shorter history joins on its first row of history (until then its state is stepped but not
+// used). Lanes share each row's step: the mean of the sample intervals of the lanes that have
+// joined, so a recording with timing jitter advances a lane by its own interval only on average.
+class LockstepReplay {
+ public:
+  LockstepReplay(const ReplayModel& model, const DiagData& d, const Segment* const* segs, const int* histories,
+                 int count, int lanes, const ReplayOptions& o)
+      : model_(model), d_(d), view_(model, d), segs_(segs), histories_(histories), count_(count), lanes_(lanes), o_(o),
+        nx_(model.states()), time_state_(model.time_index()),
+        history_(*std::max_element(histories, histories + count)) {
+    // The rows more than o.wheel_prime_s before the start run the actuator chains alone.
+    while (wheel_rows_ < history_ && static_cast<double>(history_ - wheel_rows_) * d.dt_s > o.wheel_prime_s)
+      ++wheel_rows_;
+  }
+
+  // Writes lane j's predictions to outs[j] (kPredStride values per row of its segment).
+  void run(double* const* outs) {
+    for (int j = 0; j < lanes_; ++j) start_lane(j);  // a lane that joins later is started again then
+    // Unmeasured states (actuator chains, wheel speeds) settle over the history with the measured
+    // states forced back to the recording at every sample; the velocities through a constant-gain
+    // observer (raw on a lane's first row of the full model, then blended by o.observer_gain),
+    // which takes sensor noise off the start state.
+    for (int r = wheel_rows_; r <= history_; ++r) {
+      for (int j = 0; j < lanes_; ++j) {
+        const int first_full_row = std::max(wheel_rows_, joins_at(j));
+        if (r < first_full_row) continue;
+        if (r == first_full_row && r > wheel_rows_) start_lane(j);  // it joins now
+        const float gain = r == first_full_row ? 1.f : static_cast<float>(o_.observer_gain);
+        view_.force_measured(data_row(j, r), xs_ + j, lanes_, time_state_, gain);
+      }
+      if (r == history_) break;
+      advance_row(r);
+    }
+    for (int i = 0; i < segs_[0]->len; ++i) {
+      advance_row(history_ + i);
+      for (int j = 0; j < count_; ++j)
+        view_.measurement_of(xs_ + j, lanes_, outs[j] + static_cast<std::ptrdiff_t>(i) * kPredStride);
+    }
+  }
+
+ private:
+  static constexpr int L = ReplayModel::kLanes;
+  const Segment& seg(int j) const { return *segs_[j < count_ ? j : 0]; }
+  int joins_at(int j) const { return history_ - histories_[j < count_ ? j : 0]; }
+  // The data row of lane j on row r (r = history_: its segment's start).
+  std::size_t data_row(int j, int r) const {
+    return static_cast<std::size_t>(static_cast<std::ptrdiff_t>(seg(j).start) + r - history_);
+  }
+  int substeps_of(double dt) const { return std::max(1, static_cast<int>(std::lround(dt / o_.substep_s))); }
+
+  // Lane j's start state at its first row of history: the measured state at its segment's start,
+  // the actuators at rest at the command then, run alone over the chain-only rows.
+  void start_lane(int j) {
     float lane_state[ReplayModel::kMaxStates];
     const std::size_t k0 = seg(j).start;
     VehicleState vs;
-    vs.x_m = static_cast<float>(d.x[k0]);
-    vs.y_m = static_cast<float>(d.y[k0]);
-    vs.yaw_rad = static_cast<float>(d.yaw[k0]);
-    vs.vx_mps = view.true_vx(k0);
-    vs.vy_mps = view.true_vy(k0);
-    vs.yaw_rate_radps = view.true_r(k0);
-    if (view.roll_at(k0)) vs.roll_rad = static_cast<float>(d.roll[k0]);
-    model.init_state(vs, lane_state);
-    lane_state[time_state] = static_cast<float>(d.t[k0]);
+    vs.x_m = static_cast<float>(d_.x[k0]);
+    vs.y_m = static_cast<float>(d_.y[k0]);
+    vs.yaw_rad = static_cast<float>(d_.yaw[k0]);
+    vs.vx_mps = view_.true_vx(k0);
+    vs.vy_mps = view_.true_vy(k0);
+    vs.yaw_rate_radps = view_.true_r(k0);
+    if (view_.roll_at(k0)) vs.roll_rad = static_cast<float>(d_.roll[k0]);
+    model_.init_state(vs, lane_state);
+    lane_state[time_state_] = static_cast<float>(d_.t[k0]);
     float s, t;
-    view.command_over(data_row(j, joins_at(j)), &s, &t);
-    model.set_actuators(lane_state, s, t);
-    for (int r = joins_at(j); r < wheel_rows; ++r) {
+    view_.command_over(data_row(j, joins_at(j)), &s, &t);
+    model_.set_actuators(lane_state, s, t);
+    for (int r = joins_at(j); r < wheel_rows_; ++r) {
       const std::size_t k = data_row(j, r);
-      view.force_measured(k, lane_state, 1, time_state, 1.f);
-      view.command_over(k, &s, &t);
-      model.advance_actuators(lane_state, s, t, static_cast<float>(d.t[k + 1] - d.t[k]));
+      view_.force_measured(k, lane_state, 1, time_state_, 1.f);
+      view_.command_over(k, &s, &t);
+      model_.advance_actuators(lane_state, s, t, static_cast<float>(d_.t[k + 1] - d_.t[k]));
     }
-    for (int i = 0; i < nx; ++i) xs[i * lanes + j] = lane_state[i];
-  };
-  for (int j = 0; j < lanes; ++j) start_lane(j);  // a lane that joins later is started again then
-  float u[2 * L];
-  double lane_dt[L];
-  bool joined[L];
-  float outlier_state[ReplayModel::kMaxStates];
-  // Substeps of one row's interval: about o.substep_s each.
-  auto substeps_of = [&](double dt) { return std::max(1, static_cast<int>(std::lround(dt / o.substep_s))); };
-  // Row r of every lane: the commands and interval of its data row (lanes that have not joined:
+    for (int i = 0; i < nx_; ++i) xs_[i * lanes_ + j] = lane_state[i];
+  }
+
+  // Row r of every lane: the commands and interval of its data row (a lane that has not joined:
   // no command, the shared step).
-  auto advance_row = [&](int r) {
-    for (int j = 0; j < lanes; ++j) {
-      joined[j] = r >= joins_at(j);
-      if (!joined[j]) {
-        u[j] = u[lanes + j] = 0.f;
+  void advance_row(int r) {
+    for (int j = 0; j < lanes_; ++j) {
+      joined_[j] = r >= joins_at(j);
+      if (!joined_[j]) {
+        u_[j] = u_[lanes_ + j] = 0.f;
         continue;
       }
       const std::size_t k = data_row(j, r);
-      view.command_over(k, &u[j], &u[lanes + j]);
-      lane_dt[j] = d.t[k + 1] - d.t[k];
+      view_.command_over(k, &u_[j], &u_[lanes_ + j]);
+      lane_dt_[j] = d_.t[k + 1] - d_.t[k];
     }
-    if (lanes == 1) {
-      const int n = substeps_of(lane_dt[0]);
-      for (int i = 0; i < n; ++i) model.step(xs, u[0], u[1], static_cast<float>(lane_dt[0] / n));
+    if (lanes_ == 1) {
+      const int n = substeps_of(lane_dt_[0]);
+      for (int i = 0; i < n; ++i) model_.step(xs_, u_[0], u_[1], static_cast<float>(lane_dt_[0] / n));
       return;
     }
-    // The lanes whose interval is within kSharedStepTolerance of the median share one step, the
-    // mean of their intervals (timing jitter); a lane whose interval differs more (a missing row
-    // doubles it) takes its own steps from the same start, one lane at a time.
+    const double shared = shared_step();
+    int outliers[L], outlier_count = 0;
+    float before[ReplayModel::kMaxStates * L];
+    for (int j = 0; j < lanes_; ++j)
+      if (!shares_[j]) outliers[outlier_count++] = j;
+    if (outlier_count > 0) std::copy(xs_, xs_ + nx_ * lanes_, before);
+    const int n = substeps_of(shared);
+    model_.step_lanes(xs_, u_, static_cast<float>(shared / n), n);
+    // A lane whose interval is not shared takes its own steps from the same start.
+    float lane_state[ReplayModel::kMaxStates];
+    for (int i = 0; i < outlier_count; ++i) {
+      const int j = outliers[i];
+      for (int c = 0; c < nx_; ++c) lane_state[c] = before[c * lanes_ + j];
+      const int m = substeps_of(lane_dt_[j]);
+      for (int q = 0; q < m; ++q) model_.step(lane_state, u_[j], u_[lanes_ + j], static_cast<float>(lane_dt_[j] / m));
+      for (int c = 0; c < nx_; ++c) xs_[c * lanes_ + j] = lane_state[c];
+    }
+  }
+
+  // The lanes whose interval is within kSharedStepTolerance of the joined lanes' median share one
+  // step, the mean of their intervals (timing jitter); a lane whose interval differs more (a
+  // missing row doubles it) does not (shares_[j] false). Lanes that have not joined share it.
+  double shared_step() {
     double sorted[L];
     int joined_count = 0;
-    for (int j = 0; j < lanes; ++j)
-      if (joined[j]) sorted[joined_count++] = lane_dt[j];
+    for (int j = 0; j < lanes_; ++j)
+      if (joined_[j]) sorted[joined_count++] = lane_dt_[j];
     const auto [min_dt, max_dt] = std::minmax_element(sorted, sorted + joined_count);
     double median = *min_dt;  // when max - min <= tolerance x min, every lane is within it of the median
     if (*max_dt - *min_dt > kSharedStepTolerance * *min_dt) {
       std::nth_element(sorted, sorted + joined_count / 2, sorted + joined_count);
       median = sorted[joined_count / 2];
     }
-    auto shares = [&](int j) { return !joined[j] || std::abs(lane_dt[j] - median) <= kSharedStepTolerance * median; };
     double shared = 0;
     int sharing = 0;
-    for (int j = 0; j < lanes; ++j)
-      if (joined[j] && shares(j)) {
-        shared += lane_dt[j];
+    for (int j = 0; j < lanes_; ++j) {
+      shares_[j] = !joined_[j] || std::abs(lane_dt_[j] - median) <= kSharedStepTolerance * median;
+      if (joined_[j] && shares_[j]) {
+        shared += lane_dt_[j];
         ++sharing;
       }
-    shared /= sharing;
-    int outliers[L], outlier_count = 0;
-    float before[ReplayModel::kMaxStates * L];
-    for (int j = 0; j < lanes; ++j)
-      if (!shares(j)) outliers[outlier_count++] = j;
-    if (outlier_count > 0) std::copy(xs, xs + nx * lanes, before);
-    const int n = substeps_of(shared);
-    model.step_lanes(xs, u, static_cast<float>(shared / n), n);
-    for (int i = 0; i < outlier_count; ++i) {
-      const int j = outliers[i];
-      for (int c = 0; c < nx; ++c) outlier_state[c] = before[c * lanes + j];
-      const int m = substeps_of(lane_dt[j]);
-      for (int q = 0; q < m; ++q) model.step(outlier_state, u[j], u[lanes + j], static_cast<float>(lane_dt[j] / m));
-      for (int c = 0; c < nx; ++c) xs[c * lanes + j] = outlier_state[c];
     }
-  };
-  // Velocities: a constant-gain observer (blend of the model's value and the measurement) once
-  // the full model runs, which takes sensor noise off the start state: raw on a lane's first row
-  // of the full model, then blended by o.observer_gain.
-  for (int r = wheel_rows; r <= history; ++r) {
-    for (int j = 0; j < lanes; ++j) {
-      const int first_full_row = std::max(wheel_rows, joins_at(j));
-      if (r < first_full_row) continue;
-      if (r == first_full_row && r > wheel_rows) start_lane(j);  // it joins now
-      const float gain = r == first_full_row ? 1.f : static_cast<float>(o.observer_gain);
-      view.force_measured(data_row(j, r), xs + j, lanes, time_state, gain);
-    }
-    if (r == history) break;
-    advance_row(r);
+    return shared / sharing;
   }
-  for (int i = 0; i < len; ++i) {
-    advance_row(history + i);
-    for (int j = 0; j < count; ++j)
-      view.measurement_of(xs + j, lanes, outs[j] + static_cast<std::ptrdiff_t>(i) * kPredStride);
-  }
+
+  const ReplayModel& model_;
+  const DiagData& d_;
+  const RecordingView view_;
+  const Segment* const* segs_;
+  const int* histories_;
+  const int count_, lanes_;
+  const ReplayOptions& o_;
+  const int nx_, time_state_, history_;
+  int wheel_rows_ = 0;
+  alignas(64) float xs_[ReplayModel::kMaxStates * L];
+  float u_[2 * L];
+  double lane_dt_[L];
+  bool joined_[L], shares_[L];
+};
+
+void predict_lockstep(const ReplayModel& model, const DiagData& d, const Segment* const* segs, double* const* outs,
+                      const int* histories, int count, int lanes, const ReplayOptions& o) {
+  LockstepReplay(model, d, segs, histories, count, lanes, o).run(outs);
 }
 
 }  // namespace
