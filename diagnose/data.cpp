@@ -8,105 +8,140 @@
 
 namespace mppi::diagnose {
 
-DiagData prepare(const sim::Recording& rec, const std::string& source, std::size_t min_rows,
-                 const ScreenOptions& screen) {
-  DiagData d;
-  d.source = source;
-  d.metadata = rec.metadata;
+namespace {
+
+// The recording's columns and what its metadata says of its command timing and throttle channel.
+void read_columns(const sim::Recording& rec, const std::string& source, DiagData* d) {
   for (const auto& c : sim::kRecordingRequiredColumns)
     if (!rec.has_column(c)) throw Error(source + ": missing required column '" + c + "'");
-  d.t = rec.column("t");
-  d.x = rec.column("x");
-  d.y = rec.column("y");
-  d.yaw = rec.column("yaw");
-  d.vx = rec.column("vx");
-  d.vy = rec.column("vy");
-  d.r = rec.column("yaw_rate");
-  d.steer = rec.column("steer");
-  d.throttle = rec.column("throttle");
-  if (rec.has_column("roll")) d.roll = rec.column("roll");
+  d->t = rec.column("t");
+  d->x = rec.column("x");
+  d->y = rec.column("y");
+  d->yaw = rec.column("yaw");
+  d->vx = rec.column("vx");
+  d->vy = rec.column("vy");
+  d->r = rec.column("yaw_rate");
+  d->steer = rec.column("steer");
+  d->throttle = rec.column("throttle");
+  if (rec.has_column("roll")) d->roll = rec.column("roll");
   const auto src = rec.metadata.find("source");
-  d.control_lead = (src != rec.metadata.end() &&
-                    (src->second == "mppi-sim" || src->second.rfind("mppi-fit synth", 0) == 0))
-                       ? 1 : 0;
+  d->control_lead = (src != rec.metadata.end() &&
+                     (src->second == "mppi-sim" || src->second.rfind("mppi-fit synth", 0) == 0))
+                        ? 1 : 0;
   const auto command = rec.metadata.find("throttle_command");
   if (command != rec.metadata.end()) {
     if (command->second != "speed" && command->second != "throttle")
       throw Error(source + ": metadata 'throttle_command: " + command->second + "': expected 'speed' or 'throttle'");
-    d.speed_command = command->second == "speed";
+    d->speed_command = command->second == "speed";
   }
-  const std::size_t n = d.t.size();
-  min_rows = std::max<std::size_t>(min_rows, 2);  // the sample interval needs two rows
-  if (n < min_rows)
-    throw Error(source + ": too short for diagnosis: " + std::to_string(n) + " rows, need at least " +
-                std::to_string(min_rows));
+}
+
+// The median of the intervals between rows (t has at least two).
+double median_interval_s(const std::vector<double>& t) {
   std::vector<double> dts;
-  for (std::size_t k = 1; k < n; ++k) dts.push_back(d.t[k] - d.t[k - 1]);
+  for (std::size_t k = 1; k < t.size(); ++k) dts.push_back(t[k] - t[k - 1]);
   std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
-  d.dt_s = dts[dts.size() / 2];
-  if (!(d.dt_s > 0)) throw Error(source + ": cannot determine the sample interval");
-  std::vector<ScreenColumn> columns = {{"t", &d.t},   {"x", &d.x},   {"y", &d.y},
-                                       {"yaw", &d.yaw}, {"vx", &d.vx}, {"vy", &d.vy},
-                                       {"yaw_rate", &d.r}, {"steer", &d.steer}, {"throttle", &d.throttle}};
-  if (!d.roll.empty()) columns.push_back({"roll", &d.roll});
-  d.flags = screen_columns(d.t, columns, screen);
-  for (ScreenFlag& f : d.flags) f.file = source;
-  const std::vector<char> screened = screened_rows(n, d.flags, screen.guard_rows);
-  // Pieces: cut at NaN rows, screened rows, gaps > 3 median intervals, position jumps no car
-  // makes, and displacements that the measured velocities do not account for (a respawn or a
-  // teleport: at a low sample rate a jump of a track's half width is within what a car covers
-  // between two rows, but not in that direction or at that speed).
-  auto unexplained_displacement_m = [&](std::size_t k) {
-    const double dt = d.t[k] - d.t[k - 1];
-    const double c0 = std::cos(d.yaw[k - 1]), s0 = std::sin(d.yaw[k - 1]);
-    const double c1 = std::cos(d.yaw[k]), s1 = std::sin(d.yaw[k]);
-    const double px = 0.5 * dt * (c0 * d.vx[k - 1] - s0 * d.vy[k - 1] + c1 * d.vx[k] - s1 * d.vy[k]);
-    const double py = 0.5 * dt * (s0 * d.vx[k - 1] + c0 * d.vy[k - 1] + s1 * d.vx[k] + c1 * d.vy[k]);
-    return std::hypot(d.x[k] - d.x[k - 1] - px, d.y[k] - d.y[k - 1] - py);
-  };
-  auto row_ok = [&](std::size_t k) {
-    const double vals[] = {d.t[k], d.x[k], d.y[k], d.yaw[k], d.vx[k], d.vy[k], d.r[k], d.steer[k], d.throttle[k]};
-    bool ok = !screened[k];
-    for (double v : vals) ok = ok && std::isfinite(v);
-    return ok;
-  };
-  // The threshold (also the slack of the position-jump rule) scales with the recording's own
-  // typical disagreement (position noise, a fused estimate's lag), so that noisy positions do
-  // not cut everywhere.
+  return dts[dts.size() / 2];
+}
+
+// Screens every column (screen.hpp) into d->flags; returns the rows screened out.
+std::vector<char> screen_recording(const std::string& source, const ScreenOptions& screen, DiagData* d) {
+  std::vector<ScreenColumn> columns = {{"t", &d->t},   {"x", &d->x},   {"y", &d->y},
+                                       {"yaw", &d->yaw}, {"vx", &d->vx}, {"vy", &d->vy},
+                                       {"yaw_rate", &d->r}, {"steer", &d->steer}, {"throttle", &d->throttle}};
+  if (!d->roll.empty()) columns.push_back({"roll", &d->roll});
+  d->flags = screen_columns(d->t, columns, screen);
+  for (ScreenFlag& f : d->flags) f.file = source;
+  return screened_rows(d->t.size(), d->flags, screen.guard_rows);
+}
+
+// The displacement from row k - 1 to row k that the measured velocities do not account for [m].
+double unexplained_displacement_m(const DiagData& d, std::size_t k) {
+  const double dt = d.t[k] - d.t[k - 1];
+  const double c0 = std::cos(d.yaw[k - 1]), s0 = std::sin(d.yaw[k - 1]);
+  const double c1 = std::cos(d.yaw[k]), s1 = std::sin(d.yaw[k]);
+  const double px = 0.5 * dt * (c0 * d.vx[k - 1] - s0 * d.vy[k - 1] + c1 * d.vx[k] - s1 * d.vy[k]);
+  const double py = 0.5 * dt * (s0 * d.vx[k - 1] + c0 * d.vy[k - 1] + s1 * d.vx[k] + c1 * d.vy[k]);
+  return std::hypot(d.x[k] - d.x[k - 1] - px, d.y[k] - d.y[k - 1] - py);
+}
+
+// A row not screened out, with every required value finite.
+bool row_ok(const DiagData& d, const std::vector<char>& screened, std::size_t k) {
+  const double vals[] = {d.t[k], d.x[k], d.y[k], d.yaw[k], d.vx[k], d.vy[k], d.r[k], d.steer[k], d.throttle[k]};
+  bool ok = !screened[k];
+  for (double v : vals) ok = ok && std::isfinite(v);
+  return ok;
+}
+
+// The threshold (also the slack of the position-jump rule) scales with the recording's own
+// typical disagreement (position noise, a fused estimate's lag), so that noisy positions do
+// not cut everywhere.
+double teleport_threshold_m(const DiagData& d, const std::vector<char>& screened) {
   double teleport_m = 0.25;
-  {
-    std::vector<double> e;
-    for (std::size_t k = 1; k < n; ++k)
-      if (row_ok(k) && row_ok(k - 1) && d.t[k] - d.t[k - 1] <= 3 * d.dt_s) e.push_back(unexplained_displacement_m(k));
-    if (!e.empty()) {
-      std::nth_element(e.begin(), e.begin() + static_cast<std::ptrdiff_t>(e.size() / 2), e.end());
-      teleport_m = std::max(teleport_m, 10.0 * e[e.size() / 2]);
-    }
+  std::vector<double> e;
+  for (std::size_t k = 1; k < d.t.size(); ++k)
+    if (row_ok(d, screened, k) && row_ok(d, screened, k - 1) && d.t[k] - d.t[k - 1] <= 3 * d.dt_s)
+      e.push_back(unexplained_displacement_m(d, k));
+  if (!e.empty()) {
+    std::nth_element(e.begin(), e.begin() + static_cast<std::ptrdiff_t>(e.size() / 2), e.end());
+    teleport_m = std::max(teleport_m, 10.0 * e[e.size() / 2]);
   }
-  d.piece.assign(n, -1);
+  return teleport_m;
+}
+
+// Numbers the pieces of d->piece (-1: a row in none) and counts d->screened_rows; returns the
+// usable rows. Pieces: cut at NaN rows, screened rows, gaps > 3 median intervals, position jumps
+// no car makes, and displacements that the measured velocities do not account for (a respawn or a
+// teleport: at a low sample rate a jump of a track's half width is within what a car covers
+// between two rows, but not in that direction or at that speed).
+std::size_t cut_into_pieces(const std::vector<char>& screened, double teleport_m, DiagData* d) {
+  const std::size_t n = d->t.size();
+  d->piece.assign(n, -1);
   int id = -1;
   bool open = false;
   std::size_t usable = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    const bool ok = row_ok(k);
-    if (screened[k]) ++d.screened_rows;
+    const bool ok = row_ok(*d, screened, k);
+    if (screened[k]) ++d->screened_rows;
     if (!ok) {
       open = false;
       continue;
     }
     if (open && k > 0) {
-      const double gap = d.t[k] - d.t[k - 1];
-      const double jump = std::hypot(d.x[k] - d.x[k - 1], d.y[k] - d.y[k - 1]);
-      const double vmax = std::max(std::abs(d.vx[k]), std::abs(d.vx[k - 1])) + 2.0;
-      if (gap > 3 * d.dt_s || jump > 3 * vmax * gap + teleport_m || unexplained_displacement_m(k) > teleport_m) open = false;
+      const double gap = d->t[k] - d->t[k - 1];
+      const double jump = std::hypot(d->x[k] - d->x[k - 1], d->y[k] - d->y[k - 1]);
+      const double vmax = std::max(std::abs(d->vx[k]), std::abs(d->vx[k - 1])) + 2.0;
+      if (gap > 3 * d->dt_s || jump > 3 * vmax * gap + teleport_m || unexplained_displacement_m(*d, k) > teleport_m)
+        open = false;
     }
     if (!open) {
       ++id;
       open = true;
     }
-    d.piece[k] = id;
+    d->piece[k] = id;
     ++usable;
   }
+  return usable;
+}
+
+}  // namespace
+
+DiagData prepare(const sim::Recording& rec, const std::string& source, std::size_t min_rows,
+                 const ScreenOptions& screen) {
+  DiagData d;
+  d.source = source;
+  d.metadata = rec.metadata;
+  read_columns(rec, source, &d);
+  const std::size_t n = d.t.size();
+  min_rows = std::max<std::size_t>(min_rows, 2);  // the sample interval needs two rows
+  if (n < min_rows)
+    throw Error(source + ": too short for diagnosis: " + std::to_string(n) + " rows, need at least " +
+                std::to_string(min_rows));
+  d.dt_s = median_interval_s(d.t);
+  if (!(d.dt_s > 0)) throw Error(source + ": cannot determine the sample interval");
+  const std::vector<char> screened = screen_recording(source, screen, &d);
+  const double teleport_m = teleport_threshold_m(d, screened);
+  const std::size_t usable = cut_into_pieces(screened, teleport_m, &d);
   if (usable < min_rows)
     throw Error(source + ": only " + std::to_string(usable) + " usable rows (no empty fields), need " +
                 std::to_string(min_rows));

@@ -155,37 +155,28 @@ std::vector<std::pair<double, double>> speed_schedule(std::uint64_t seed, double
   return out;
 }
 
-int synthesize(const SynthOptions& o, const std::string& csv_path) {
-  if (o.work_dir.empty()) throw Error("synthesize: work_dir is required");
-  std::filesystem::create_directories(o.work_dir);
-  model_family_of([&] {  // throws for a model without an effects version
-    CorrectedModelFile f;
-    f.nominal_model = o.nominal_model;
-    return f;
-  }());
-  CorrectedModelFile truth;
-  truth.nominal_model = o.nominal_model;
-  truth.effects = o.truth;
-  truth.selected = o.truth_ids;
-  const std::string truth_path = o.work_dir + "/truth_model.yaml";
-  std::ofstream(truth_path) << corrected_model_to_yaml(truth, "hidden truth of a synthetic recording");
+namespace {
 
+// The closed-loop run that drives the hidden truth (the plant) with the nominal model's controller;
+// *schedule_text: its target speeds, as the recording's metadata gives them.
+sim::ClosedLoopConfig closed_loop_config(const SynthOptions& o, const std::string& truth_path,
+                                         std::string* schedule_text) {
   sim::ClosedLoopConfig c;
   c.track = o.track;
   c.model = o.nominal_model;
   c.plant = "corrected";
   c.plant_params_yaml = truth_path;
   c.target_speed_mps = o.target_speed_mps;
-  std::string schedule_text = "constant " + std::to_string(o.target_speed_mps);
+  *schedule_text = "constant " + std::to_string(o.target_speed_mps);
   if (o.vary_speed && o.speed_max_mps > o.speed_min_mps) {
     c.target_speed_schedule =
         speed_schedule(o.seed, o.duration_s, o.speed_min_mps, o.speed_max_mps, o.hold_min_s, o.hold_max_s);
     c.target_speed_mps = c.target_speed_schedule.front().second;
-    schedule_text.clear();
+    schedule_text->clear();
     char b[48];
     for (const auto& [from_s, v] : c.target_speed_schedule) {
-      std::snprintf(b, sizeof b, "%s%.2f:%.2f", schedule_text.empty() ? "" : " ", from_s, v);
-      schedule_text += b;
+      std::snprintf(b, sizeof b, "%s%.2f:%.2f", schedule_text->empty() ? "" : " ", from_s, v);
+      *schedule_text += b;
     }
   }
   c.laps = 1000;
@@ -199,9 +190,12 @@ int synthesize(const SynthOptions& o, const std::string& csv_path) {
   c.actuators.throttle_rate_per_s = 1e4f;
   c.out_dir = o.work_dir + "/run";
   c.progress = false;
-  const sim::RunSummary summary = sim::run_closed_loop(c);
+  return c;
+}
 
-  const sim::Recording raw = sim::RecordingReader::read(c.out_dir + "/log.csv");
+// The run's log with sensor noise on the measured states, written to csv_path.
+void write_noisy_recording(const SynthOptions& o, const sim::Recording& raw, const std::string& csv_path,
+                           const std::string& truth_path, const std::string& schedule_text, int crashes) {
   std::mt19937_64 rng(o.seed * 7919 + 17);
   std::normal_distribution<double> n01(0.0, o.noise.scale);
   std::string ids;
@@ -215,7 +209,7 @@ int synthesize(const SynthOptions& o, const std::string& csv_path) {
                           {"truth_effects", ids.empty() ? "none" : ids},
                           {"truth_model", truth_path},
                           {"target_speed_schedule_s_mps", schedule_text},
-                          {"crashes", std::to_string(summary.crashes)}});
+                          {"crashes", std::to_string(crashes)}});
   const auto& t = raw.column("t");
   const auto& x = raw.column("x");
   const auto& y = raw.column("y");
@@ -240,6 +234,31 @@ int synthesize(const SynthOptions& o, const std::string& csv_path) {
     w.write_row(row);
   }
   w.close();
+}
+
+}  // namespace
+
+int synthesize(const SynthOptions& o, const std::string& csv_path) {
+  if (o.work_dir.empty()) throw Error("synthesize: work_dir is required");
+  std::filesystem::create_directories(o.work_dir);
+  model_family_of([&] {  // throws for a model without an effects version
+    CorrectedModelFile f;
+    f.nominal_model = o.nominal_model;
+    return f;
+  }());
+  CorrectedModelFile truth;
+  truth.nominal_model = o.nominal_model;
+  truth.effects = o.truth;
+  truth.selected = o.truth_ids;
+  const std::string truth_path = o.work_dir + "/truth_model.yaml";
+  std::ofstream(truth_path) << corrected_model_to_yaml(truth, "hidden truth of a synthetic recording");
+
+  std::string schedule_text;
+  const sim::ClosedLoopConfig c = closed_loop_config(o, truth_path, &schedule_text);
+  const sim::RunSummary summary = sim::run_closed_loop(c);
+
+  const sim::Recording raw = sim::RecordingReader::read(c.out_dir + "/log.csv");
+  write_noisy_recording(o, raw, csv_path, truth_path, schedule_text, summary.crashes);
   return summary.crashes;
 }
 
