@@ -4,6 +4,7 @@
 // command sequences from different seeds), and the plant's parameters are chosen to minimise
 // its 1-s open-loop prediction error on the training set (sysid/plant_calibration.hpp). Reports
 // the held-out normalised RMSE per channel and lead time before and after. docs/CALIBRATION.md.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -22,17 +23,20 @@
 #include "mppi_fit_bag.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"
+#include "sysid/estimable_models.hpp"
 #include "sysid/manoeuvre_rollout.hpp"
 #include "sysid/plant_calibration.hpp"
 #include "sysid/vehicle_estimation.hpp"
 
 namespace {
 
-const char* kCalibrateUsage = R"(usage: mppi-fit calibrate [options]
+// The usage is kUsageHead, the --model line (calibrate_usage) and kUsageTail.
+const char* kUsageHead = R"(usage: mppi-fit calibrate [options]
   --network FILE       learned dynamics used as the recording of the car
                        (default data/autorally/models/autorally_nnet_09_12_2018.npz)
-  --model NAME         single-track | double-track | full-vehicle         (single-track)
-  --params FILE        starting (and "before") parameters
+)";
+
+const char* kUsageTail = R"(  --params FILE        starting (and "before") parameters
                        (default data/config/autorally_<model>_uncalibrated.yaml)
   --estimate A,B,...   parameters to fit (default: max_steer_rad, stall_torque_Nm,
                        no_load_speed_mps, brake_torque_ratio, rolling_resistance,
@@ -65,6 +69,17 @@ const char* kCalibrateUsage = R"(usage: mppi-fit calibrate [options]
                        step response), summary.txt, train.csv, heldout.csv
                                                                             (out/calibrate)
 )";
+
+// The option help with the --model choices from the estimable models.
+std::string calibrate_usage() {
+  const std::size_t default_column = 74;
+  std::string model_line = "  --model NAME         ";
+  const std::vector<std::string> names = mppi::sysid::estimable_model_names();
+  for (std::size_t i = 0; i < names.size(); ++i) model_line += (i == 0 ? "" : " | ") + names[i];
+  model_line.resize(std::max(default_column, model_line.size() + 1), ' ');
+  model_line += "(" + std::string(mppi::models::SingleTrackModel::kName) + ")\n";
+  return kUsageHead + model_line + kUsageTail;
+}
 
 std::vector<std::string> split_list(const std::string& s) {
   std::vector<std::string> out;
@@ -172,15 +187,13 @@ int mppi_fit_calibrate(int argc, char** argv) {
         return argv[++i];
       };
       if (a == "--help" || a == "-h") {
-        std::fputs(kCalibrateUsage, stdout);
+        std::fputs(calibrate_usage().c_str(), stdout);
         return 0;
       } else if (a == "--network") {
         network_file = value();
       } else if (a == "--model") {
         model = value();
-        if (model != models::SingleTrackModel::kName && model != models::DoubleTrackModel::kName &&
-            model != models::FullVehicleModel::kName)
-          throw Error("--model expects single-track, double-track or full-vehicle, got '" + model + "'");
+        with_estimable_model(model, []<class E>() {}, "--model");
       } else if (a == "--params") {
         params_file = value();
       } else if (a == "--estimate") {
@@ -224,7 +237,7 @@ int mppi_fit_calibrate(int argc, char** argv) {
     std::string why;
     if (!train_opt.is_valid(&why) || !held_opt.is_valid(&why) || !cal.is_valid(&why)) throw Error(why);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "mppi-fit calibrate: %s\n%s", e.what(), kCalibrateUsage);
+    std::fprintf(stderr, "mppi-fit calibrate: %s\n%s", e.what(), calibrate_usage().c_str());
     return 2;
   }
 
@@ -246,19 +259,14 @@ int mppi_fit_calibrate(int argc, char** argv) {
     for (const std::string& f : heldout_logs) held_log_pieces.push_back(read_learned_model_log(f));
 
     VehicleModelSpec spec;
-    if (model == models::SingleTrackModel::kName) {
-      if (params_file.empty()) params_file = uncalibrated_file(models::SingleTrackModel::kDefaultFile);
-      spec = single_track_spec(load_single_track_params(params_file), names);
-    } else if (model == models::DoubleTrackModel::kName) {
-      if (params_file.empty()) params_file = uncalibrated_file(models::DoubleTrackModel::kDefaultFile);
-      spec = double_track_spec(load_double_track_params(params_file), names);
-    } else {
-      if (params_file.empty()) params_file = uncalibrated_file(models::FullVehicleModel::kDefaultFile);
-      // The full vehicle's drag is drag_coefficient (x air density x frontal area / 2).
+    bool actuator_terms = false;
+    with_estimable_model(model, [&]<class E>() {
+      if (params_file.empty()) params_file = uncalibrated_file(E::Descriptor::kDefaultFile);
       for (std::string& n : names)
-        if (n == "aero_drag_kgpm") n = "drag_coefficient";
-      spec = full_vehicle_spec(load_full_vehicle_params(params_file), names);
-    }
+        if (n == "aero_drag_kgpm") n = E::kDragParam;
+      spec = E::spec(E::load_params(params_file), names);
+      actuator_terms = E::kActuatorTerms;
+    });
 
     const std::vector<double> train_scales = channel_scales(train, cal.error.channels);
     const std::vector<double> held_scales = channel_scales(held, cal.error.channels);
@@ -289,7 +297,8 @@ int mppi_fit_calibrate(int argc, char** argv) {
             }
       std::ofstream y(out_dir + "/calibrated.yaml");
       const std::string comment = model + " parameters calibrated by mppi-fit calibrate to " + net_path;
-      if (actuators && model == models::SingleTrackModel::kName) {
+      // Only the single-track's spec has actuator terms (E::kActuatorTerms): the file's nominal.
+      if (actuators && actuator_terms) {
         corrected.nominal = single_track_params_from_yaml(spec.to_yaml(fit.values), out_dir + "/calibrated.yaml");
         for (const EffectSpec& e : effect_table())
           for (const EffectParamSpec& q : e.params)

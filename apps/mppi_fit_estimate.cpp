@@ -20,6 +20,7 @@
 #include "mppi_fit_bag.hpp"
 #include "mppi_fit_commands.hpp"
 #include "sim/data_dir.hpp"
+#include "sysid/estimable_models.hpp"
 #include "sysid/estimation_plots.hpp"
 #include "sysid/observability.hpp"
 #include "sysid/real_data.hpp"
@@ -44,17 +45,8 @@ struct EstimateArgs {
   double horizon_s = 1.0, rank_tol = 1e-7;
 };
 
-// The models estimate has a joint-state version of (sysid/vehicle_estimation.hpp).
-std::vector<std::string> estimable_models() {
-  return {mppi::models::SingleTrackModel::kName, mppi::models::DoubleTrackModel::kName,
-          mppi::models::FullVehicleModel::kName};
-}
-
 std::vector<std::string> estimable_params(const std::string& model) {
-  using namespace mppi::sysid;
-  return model == mppi::models::SingleTrackModel::kName   ? single_track_param_names()
-         : model == mppi::models::DoubleTrackModel::kName ? double_track_param_names()
-                                                          : full_vehicle_param_names();
+  return mppi::sysid::with_estimable_model(model, []<class E>() { return E::param_names(); });
 }
 
 int run_estimate(EstimateArgs& args) {
@@ -99,31 +91,13 @@ int run_estimate(EstimateArgs& args) {
     // Model and its base parameters.
     VehicleModelSpec spec, truth_spec;
     bool have_truth = !truth_file.empty();
-    if (model == mppi::models::SingleTrackModel::kName) {
-      const SingleTrackParams base = load_single_track_params(
-          params_file.empty() ? sim::data_file("config/autorally_single_track.yaml") : params_file);
-      if (estimate_names.empty())
-        estimate_names = {"yaw_inertia_kgm2", "cg_to_front_axle_m", "tyre.B", "tyre.C", "tyre.D"};
-      spec = single_track_spec(base, estimate_names, keep_wheelbase);
-      if (have_truth) truth_spec = single_track_spec(load_single_track_params(truth_file), estimate_names);
-    } else if (model == mppi::models::DoubleTrackModel::kName) {
-      const DoubleTrackParams base = load_double_track_params(
-          params_file.empty() ? sim::data_file("config/autorally_double_track.yaml") : params_file);
-      if (estimate_names.empty())
-        estimate_names = {"mass_kg", "yaw_inertia_kgm2", "rear_wheel_inertia_kgm2", "cg_height_m",
-                          "cg_to_front_axle_m", "tyre.B", "tyre.C", "tyre.D"};
-      spec = double_track_spec(base, estimate_names, keep_wheelbase);
-      if (have_truth) truth_spec = double_track_spec(load_double_track_params(truth_file), estimate_names);
-    } else {
-      const FullVehicleParams base = load_full_vehicle_params(
-          params_file.empty() ? sim::data_file("config/autorally_full_vehicle_uncalibrated.yaml") : params_file);
-      if (estimate_names.empty())
-        estimate_names = {"mass_kg", "yaw_inertia_kgm2", "rear_wheel_inertia_kgm2", "cg_height_m",
-                          "cg_to_front_axle_m", "tyre.B", "tyre.C", "tyre.D",
-                          "front_damper_Nspm", "rear_damper_Nspm"};
-      spec = full_vehicle_spec(base, estimate_names, keep_wheelbase);
-      if (have_truth) truth_spec = full_vehicle_spec(load_full_vehicle_params(truth_file), estimate_names);
-    }
+    with_estimable_model(model, [&]<class E>() {
+      const typename E::Params base =
+          E::load_params(params_file.empty() ? sim::data_file(E::kEstimationFile) : params_file);
+      if (estimate_names.empty()) estimate_names = E::default_estimated();
+      spec = E::spec(base, estimate_names, keep_wheelbase);
+      if (have_truth) truth_spec = E::spec(E::load_params(truth_file), estimate_names);
+    });
     const sim::Recording rec = load_any_recording(resolve(input));
     const std::size_t np = spec.estimated.size();
     std::vector<double> truth(np, NAN);
@@ -201,12 +175,7 @@ int run_estimate(EstimateArgs& args) {
     }
     // The file must load in the simulator and the controller: parse it back with their loader.
     try {
-      if (model == mppi::models::SingleTrackModel::kName)
-        (void)load_single_track_params(out_dir + "/estimated.yaml");
-      else if (model == mppi::models::DoubleTrackModel::kName)
-        (void)load_double_track_params(out_dir + "/estimated.yaml");
-      else
-        (void)load_full_vehicle_params(out_dir + "/estimated.yaml");
+      with_estimable_model(model, [&]<class E>() { (void)E::load_params(out_dir + "/estimated.yaml"); });
     } catch (const std::exception& e) {
       std::fprintf(stderr, "mppi-fit estimate: WARNING: the estimated parameters do not load: %s\n", e.what());
     }
@@ -388,7 +357,7 @@ void add_estimate_command(CLI::App& fit, FitCommands& commands) {
                   "real/dart_jetracer.zip:<member>.csv (see mppi-fit convert --list), or a rosbag FILE.bag (docs/ROSBAG.md)")
       ->type_name("RECORDING");
   add_bag_options(cmd);
-  mppi::cli::add_model_option(*cmd, "--model", args->model, "model", estimable_models());
+  mppi::cli::add_model_option(*cmd, "--model", args->model, "model", mppi::sysid::estimable_model_names());
   cmd->add_option("--params", args->params_file,
                   "base parameters (YAML of that model, keys in --list-params; default "
                   "data/config/autorally_<model>.yaml; the full vehicle: autorally_full_vehicle_uncalibrated.yaml, the paper's values)")

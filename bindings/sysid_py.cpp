@@ -21,6 +21,7 @@
 #include "sim/data_dir.hpp"
 #include "sim/recording.hpp"
 #include "sysid/bifilar.hpp"
+#include "sysid/estimable_models.hpp"
 #include "diagnose/diagnose.hpp"
 #include "diagnose/synth.hpp"
 #include "sysid/protocol.hpp"
@@ -66,29 +67,13 @@ mppi::sim::Recording load(const std::string& spec) {
 }
 
 // ---- estimation: the model spec as mppi-fit estimate builds it ----
-const char* default_params_file(const std::string& model) {
-  if (model == mppi::models::SingleTrackModel::kName) return "config/autorally_single_track.yaml";
-  if (model == mppi::models::DoubleTrackModel::kName) return "config/autorally_double_track.yaml";
-  if (model == mppi::models::FullVehicleModel::kName) return "config/autorally_full_vehicle_uncalibrated.yaml";
-  throw mppi::Error("model: expects single-track, double-track or full-vehicle, got '" + model + "'");
-}
-
-std::vector<std::string> default_estimated(const std::string& model) {
-  if (model == mppi::models::SingleTrackModel::kName) return {"yaw_inertia_kgm2", "cg_to_front_axle_m", "tyre.B", "tyre.C", "tyre.D"};
-  std::vector<std::string> n = {"mass_kg", "yaw_inertia_kgm2", "rear_wheel_inertia_kgm2", "cg_height_m",
-                                "cg_to_front_axle_m", "tyre.B", "tyre.C", "tyre.D"};
-  if (model == mppi::models::FullVehicleModel::kName) n.insert(n.end(), {"front_damper_Nspm", "rear_damper_Nspm"});
-  return n;
-}
-
 mppi::sysid::VehicleModelSpec make_spec(const std::string& model, const std::string& params_file,
                                         std::vector<std::string> names, bool keep_wheelbase) {
-  using namespace mppi::sysid;
-  const std::string file = params_file.empty() ? mppi::sim::data_file(default_params_file(model)) : params_file;
-  if (names.empty()) names = default_estimated(model);
-  if (model == mppi::models::SingleTrackModel::kName) return single_track_spec(mppi::load_single_track_params(file), names, keep_wheelbase);
-  if (model == mppi::models::DoubleTrackModel::kName) return double_track_spec(mppi::load_double_track_params(file), names, keep_wheelbase);
-  return full_vehicle_spec(mppi::load_full_vehicle_params(file), names, keep_wheelbase);
+  return mppi::sysid::with_estimable_model(model, [&]<class E>() {
+    const std::string file = params_file.empty() ? mppi::sim::data_file(E::kEstimationFile) : params_file;
+    if (names.empty()) names = E::default_estimated();
+    return E::spec(E::load_params(file), names, keep_wheelbase);
+  }, "model:");
 }
 
 // The parameter values of `names` in a parameter file of `model` (for truth references).
@@ -427,10 +412,7 @@ void register_sysid(py::module_& m) {
 
   // ---- estimation ----
   m.def("estimation_param_names", [](const std::string& model) {
-    (void)default_params_file(model);  // validates the name
-    return model == mppi::models::SingleTrackModel::kName ? single_track_param_names()
-           : model == mppi::models::DoubleTrackModel::kName ? double_track_param_names()
-                                     : full_vehicle_param_names();
+    return with_estimable_model(model, []<class E>() { return E::param_names(); }, "model:");
   }, py::arg("model") = mppi::models::SingleTrackModel::kName, "parameter names the model can estimate (mppi-fit estimate --list-params)");
   m.def("estimate_parameters", &estimate, py::arg("recording"), py::arg("model") = mppi::models::SingleTrackModel::kName,
         py::arg("params_file") = "", py::arg("estimate") = std::vector<std::string>{}, py::arg("estimator") = "alm",

@@ -5,9 +5,12 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
+#include <type_traits>
 
 #include "base/error.hpp"
 #include "diagnose/model_family.hpp"
+#include "dynamics/corrected_model.hpp"
 #include "dynamics/model_registry.hpp"
 
 namespace mppi::diagnose {
@@ -33,12 +36,29 @@ bool metadata_number(const DiagData& d, const std::string& key, double* value) {
   }
 }
 
+// Models built from the single-track parameters or from a four-wheel set around them (as
+// corrected_nominal builds them): the file's `nominal` holds their mass and geometry.
+template <class D>
+constexpr bool kHasSingleTrackCore = std::is_constructible_v<typename D::Model, const SingleTrackParams&> ||
+                                     std::is_constructible_v<typename D::Model, const DoubleTrackParams&> ||
+                                     std::is_constructible_v<typename D::Model, const FullVehicleParams&>;
+
 // The single-track parameters that carry the model's mass and geometry, or nullptr where the
 // model has none (the network, the kinematic bicycle: its wheelbase is returned apart).
 const SingleTrackParams* vehicle_core(const CorrectedModelFile& m) {
-  using namespace mppi::models;
-  if (m.nominal_model == AutoRallyNetworkModel::kName || m.nominal_model == Kinematic::kName) return nullptr;
-  return &m.nominal;
+  bool has_core = true;
+  visit_by_name(CorrectedNominalModels{}, m.nominal_model, [&]<class D>() { has_core = kHasSingleTrackCore<D>; });
+  return has_core ? &m.nominal : nullptr;
+}
+
+// The wheelbase of a model built from the kinematic bicycle's parameters; empty for the others.
+std::optional<double> kinematic_wheelbase(const CorrectedModelFile& m) {
+  std::optional<double> wheelbase;
+  visit_by_name(CorrectedNominalModels{}, m.nominal_model, [&]<class D>() {
+    if constexpr (std::is_constructible_v<typename D::Model, const KinematicBicycleParams&>)
+      wheelbase = m.kinematic.wheelbase_m;
+  });
+  return wheelbase;
 }
 
 void check_close(const std::string& what, double model_value, double recording_value, double tolerance,
@@ -83,8 +103,9 @@ void check_model_matches_recording(const CorrectedModelFile& model, const std::s
     if (metadata_number(d, "wheelbase_m", &recorded))
       check_close("wheelbase [m]", car->cg_to_front_axle_m + car->cg_to_rear_axle_m, recorded, o.geometry_tolerance,
                   model_source, d);
-  } else if (model.nominal_model == mppi::models::Kinematic::kName && metadata_number(d, "wheelbase_m", &recorded)) {
-    check_close("wheelbase [m]", model.kinematic.wheelbase_m, recorded, o.geometry_tolerance, model_source, d);
+  } else if (const std::optional<double> wheelbase = kinematic_wheelbase(model);
+             wheelbase && metadata_number(d, "wheelbase_m", &recorded)) {
+    check_close("wheelbase [m]", *wheelbase, recorded, o.geometry_tolerance, model_source, d);
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include <fstream>
 #include <sstream>
+#include <type_traits>
 
 #include "base/multiversion.hpp"
 #include "dynamics/with_effects.hpp"
@@ -89,6 +90,21 @@ std::string read_text(const std::string& path) {
   return ss.str();
 }
 
+// A parameter file's text into the section of `f` the nominal model D is built from (as
+// corrected_nominal reads them; the single-track's for the others).
+template <class D>
+void read_nominal_params(CorrectedModelFile& f, const std::string& text, const std::string& source) {
+  using M = typename D::Model;
+  if constexpr (std::is_constructible_v<M, const DoubleTrackParams&>)
+    f.double_track = double_track_params_from_yaml(text, source);
+  else if constexpr (std::is_constructible_v<M, const FullVehicleParams&>)
+    f.full_vehicle = full_vehicle_params_from_yaml(text, source);
+  else if constexpr (std::is_constructible_v<M, const KinematicBicycleParams&>)
+    f.kinematic = kinematic_bicycle_params_from_yaml(text, source);
+  else
+    f.nominal = single_track_params_from_yaml(text, source);
+}
+
 }  // namespace
 
 std::unique_ptr<ModelFamily> model_family_of(const CorrectedModelFile& file) {
@@ -110,7 +126,9 @@ std::unique_ptr<ModelFamily> make_model_family(const std::string& model, const s
     throw Error("nominal model '" + model + "' cannot be diagnosed (valid: " + kCorrectedNominalModels + ")");
   CorrectedModelFile f;
   f.nominal_model = model;
-  if (model == mppi::models::AutoRallyNetworkModel::kName && !params_path.empty() && params_path.size() > 4 &&
+  bool weights_model = false;  // its data are weights (.npz), not a parameter table
+  visit_by_name(CorrectedNominalModels{}, model, [&]<class D>() { weights_model = !HasParamTable<D>; });
+  if (weights_model && !params_path.empty() && params_path.size() > 4 &&
       params_path.substr(params_path.size() - 4) == ".npz") {
     f.network_npz = params_path;  // the network's weights
   } else if (!params_path.empty()) {
@@ -119,14 +137,8 @@ std::unique_ptr<ModelFamily> make_model_family(const std::string& model, const s
       f = corrected_model_from_yaml(text, params_path);
       if (f.nominal_model != model)
         throw Error(params_path + ": a corrected model of a " + f.nominal_model + " nominal, but --model is " + model);
-    } else if (model == mppi::models::DoubleTrackModel::kName) {
-      f.double_track = double_track_params_from_yaml(text, params_path);
-    } else if (model == mppi::models::FullVehicleModel::kName) {
-      f.full_vehicle = full_vehicle_params_from_yaml(text, params_path);
-    } else if (model == mppi::models::Kinematic::kName) {
-      f.kinematic = kinematic_bicycle_params_from_yaml(text, params_path);
     } else {
-      f.nominal = single_track_params_from_yaml(text, params_path);
+      visit_by_name(CorrectedNominalModels{}, model, [&]<class D>() { read_nominal_params<D>(f, text, params_path); });
     }
   }
   return model_family_of(f);

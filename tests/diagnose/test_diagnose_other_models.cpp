@@ -14,6 +14,7 @@
 #include "diagnose/model_family.hpp"
 #include "diagnose/synth.hpp"
 #include "dynamics/with_effects.hpp"
+#include "sim/data_dir.hpp"
 #include "diagnose_fixtures.hpp"
 
 using namespace mppi;
@@ -140,6 +141,25 @@ TEST_CASE("corrected-model file with a double-track nominal: round trip and mism
   CHECK_THROWS_AS(make_model_family("single-track", path), Error);  // the file is a double-track one
   CHECK_THROWS_AS(make_model_family("diff-drive"), Error);
   std::filesystem::remove(path);
+}
+
+TEST_CASE("a parameter file is read as the parameters of the nominal model named", "[diagnose][other_models]") {
+  const std::string double_track = sim::data_file("config/autorally_double_track.yaml");
+  CHECK(make_model_family("single-track", sim::data_file("config/autorally_single_track.yaml"))->name() ==
+        "single-track");
+  CHECK(make_model_family("double-track", double_track)->name() == "double-track");
+  CHECK(make_model_family("full-vehicle", sim::data_file("config/autorally_full_vehicle.yaml"))->name() ==
+        "full-vehicle");
+  CHECK(make_model_family("autorally-nn", sim::data_file("autorally/models/autorally_nnet_09_12_2018.npz"))->name() ==
+        "autorally-nn");
+  const std::string kinematic = (std::filesystem::temp_directory_path() / "mppi_kinematic_params.yaml").string();
+  std::ofstream(kinematic) << "wheelbase_m: 0.61\n";
+  CHECK(make_model_family("kinematic", kinematic)->name() == "kinematic");
+  // Another model's keys are unknown keys.
+  CHECK_THROWS_AS(make_model_family("single-track", double_track), Error);
+  CHECK_THROWS_AS(make_model_family("single-track", kinematic), Error);
+  CHECK_THROWS_AS(make_model_family("kinematic", double_track), Error);
+  std::filesystem::remove(kinematic);
 }
 
 // The hidden effect (if any) of a recording generated with `model` is named from that model's

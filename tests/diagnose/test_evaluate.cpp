@@ -80,6 +80,29 @@ TEST_CASE("evaluate refuses a model and a recording of different cars, naming wh
   CHECK_NOTHROW(check_model_matches_recording(autorally, "m.yaml", prepare(own, "own.csv")));
 }
 
+TEST_CASE("evaluate checks the mass and wheelbase each nominal model has", "[diagnose][evaluate]") {
+  sim::Recording rec = steer_delayed_recording();
+  rec.metadata["mass_kg"] = "1.58";
+  const DiagData light = prepare(rec, "light.csv");
+  rec.metadata.erase("mass_kg");
+  rec.metadata["wheelbase_m"] = "0.1735";
+  const DiagData short_car = prepare(rec, "short.csv");
+  CorrectedModelFile m;
+  for (const std::string four_wheel : {models::DoubleTrackModel::kName, models::FullVehicleModel::kName}) {
+    m.nominal_model = four_wheel;  // mass and geometry in the single-track core
+    CHECK_THROWS_WITH(check_model_matches_recording(m, "m.yaml", light), Catch::Contains("mass [kg]"));
+    CHECK_THROWS_WITH(check_model_matches_recording(m, "m.yaml", short_car), Catch::Contains("wheelbase [m]"));
+  }
+  m.nominal_model = models::Kinematic::kName;  // a wheelbase, no mass
+  CHECK_NOTHROW(check_model_matches_recording(m, "m.yaml", light));
+  CHECK_THROWS_WITH(check_model_matches_recording(m, "m.yaml", short_car), Catch::Contains("wheelbase [m]"));
+  m.kinematic.wheelbase_m = 0.1735;
+  CHECK_NOTHROW(check_model_matches_recording(m, "m.yaml", short_car));
+  m.nominal_model = models::AutoRallyNetworkModel::kName;  // neither
+  CHECK_NOTHROW(check_model_matches_recording(m, "m.yaml", light));
+  CHECK_NOTHROW(check_model_matches_recording(m, "m.yaml", short_car));
+}
+
 TEST_CASE("a corrected-model file keeps its fitted_on section", "[diagnose][evaluate]") {
   CorrectedModelFile f;
   f.fitted_on["source"] = "run: 3 # left";
