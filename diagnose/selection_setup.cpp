@@ -72,10 +72,11 @@ void make_candidates(const ModelFamily& nominal, const SelectionOptions& opt, st
     const std::string& a = cands[pa]->id;
     const std::string& b = cands[pa]->partner;
     if (b.empty()) continue;
-    int ia = static_cast<int>(pa), ib = -1;
+    const int ia = static_cast<int>(pa);
+    int ib = -1;
     for (std::size_t i = 0; i < single_count; ++i)
       if (cands[i]->id == b) ib = static_cast<int>(i);
-    if (ia < 0 || ib < 0) continue;
+    if (ib < 0) continue;  // the partner is not a candidate here
     EffectSpec joint = *cands[static_cast<std::size_t>(ia)];
     joint.id = a + "+" + b;
     joint.description = "joint: " + joint.description + "; " + cands[static_cast<std::size_t>(ib)]->description;

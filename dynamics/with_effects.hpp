@@ -158,27 +158,9 @@ class WithEffects {
   const EffectParams& effects() const { return effects_; }
   std::size_t scratch_floats(int w) const { return before_.scratch_floats(w); }
 
-  // Advances one actuator chain (kChain floats) by one step with input u; returns the output.
-  static float advance_chain(float* chain, float u, const ChainCoeffs& k) noexcept {
-    float in = u;
-    for (int i = 0; i < kDelayStages; ++i) {
-      chain[i] += k.a_delay * (in - chain[i]);
-      in = chain[i];
-    }
-    float& lag = chain[kDelayStages];
-    lag += std::clamp(k.a_lag * (in - lag), -k.max_step, k.max_step);  // +-inf: no rate limit
-    float& play = chain[kDelayStages + 1];
-    if (k.backlash > 0.f) {  // the output moves only when the input pushes against a side
-      const float half = 0.5f * k.backlash;
-      play = std::clamp(play, lag - half, lag + half);
-    } else {
-      play = lag;
-    }
-    return play;
-  }
-
-  // advance_chain for W lanes at once: the chain of lane j is x[first + i][j], its input u[j];
-  // the outputs go to out[j]. The same operations as advance_chain, stage by stage.
+  // Advances one actuator chain (kChain states: the delay stages, the lag with its rate limit, the
+  // play) of W lanes by one step: the chain of lane j is x[first + i][j], its input u[j]; the
+  // outputs (what is applied) go to out[j].
   template <int W>
   static void advance_chain_lanes(Batch<kNx, W> x, int first, const float* u, const ChainCoeffs& k,
                                   float* out) noexcept {
@@ -209,8 +191,10 @@ class WithEffects {
   // Actuator chains only, one state (used to prime them from a command history).
   void advance_actuators(float* x, float steer, float throttle, float dt_s) const noexcept {
     const ActuatorCoeffs k = actuator_coeffs(effects_, dt_s);
-    advance_chain(x + kSteerChain, steer, k.steer);
-    advance_chain(x + kThrottleChain, throttle, k.throttle);
+    const Batch<kNx, 1> lane{x};
+    float applied;
+    advance_chain_lanes<1>(lane, kSteerChain, &steer, k.steer, &applied);
+    advance_chain_lanes<1>(lane, kThrottleChain, &throttle, k.throttle, &applied);
   }
 
   // The command the base model sees from the chains' outputs.
