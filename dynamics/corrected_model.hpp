@@ -4,7 +4,7 @@
 // and `mppi-sim --model corrected` / `--plant corrected` read it.
 #include <map>
 #include <string>
-#include <type_traits>
+#include <tuple>
 #include <vector>
 
 #include "dynamics/effects.hpp"
@@ -22,6 +22,8 @@ namespace mppi {
 //   nominal: double-track | full-vehicle | kinematic | autorally-nn (then nominal_params holds
 //   that model's keys, for the network `network_npz: PATH` (empty = the shipped AutoRally
 //   network), and the effects wrap it: WithEffects<...>, dynamics/with_effects.hpp)
+// A model with a parameter table reads and writes its keys through its descriptor
+// (params_from_yaml, params_to_yaml); the file keeps them in the member nominal_params_of<D>.
 struct CorrectedModelFile {
   std::string nominal_model = mppi::models::SingleTrackModel::kName;  // one of kCorrectedNominalModels
   SingleTrackParams nominal;          // single-track: the model; four-wheel: their core
@@ -44,16 +46,28 @@ inline bool is_corrected_nominal_model(const std::string& name) {
   return visit_by_name(CorrectedNominalModels{}, name, []<class D>() {});
 }
 
+// The member of `file` that holds the parameters of the nominal model D (one of
+// CorrectedNominalModels with a parameter table): the one of type D::Params. Picked by type, so
+// a new nominal model with a parameter table needs a member of its own (else this fails to
+// compile).
+template <class D>
+  requires HasParamTable<D>
+typename D::Params& nominal_params_of(CorrectedModelFile& file) {
+  return std::get<typename D::Params&>(std::tie(file.nominal, file.double_track, file.full_vehicle, file.kinematic));
+}
+template <class D>
+  requires HasParamTable<D>
+const typename D::Params& nominal_params_of(const CorrectedModelFile& file) {
+  return std::get<const typename D::Params&>(
+      std::tie(file.nominal, file.double_track, file.full_vehicle, file.kinematic));
+}
+
 // The nominal model of a file as the registered model D (one of CorrectedNominalModels); a
 // model whose data are weights is loaded from `weights_path` (the file's network_npz resolved
 // by the caller).
 template <class D>
 typename D::Model corrected_nominal(const CorrectedModelFile& file, const std::string& weights_path) {
-  using M = typename D::Model;
-  if constexpr (std::is_constructible_v<M, const SingleTrackParams&>) return M(file.nominal);
-  else if constexpr (std::is_constructible_v<M, const DoubleTrackParams&>) return M(file.double_track);
-  else if constexpr (std::is_constructible_v<M, const FullVehicleParams&>) return M(file.full_vehicle);
-  else if constexpr (std::is_constructible_v<M, const KinematicBicycleParams&>) return M(file.kinematic);
+  if constexpr (HasParamTable<D>) return D::make(nominal_params_of<D>(file));
   else return D::load(weights_path);
 }
 

@@ -1,6 +1,7 @@
 // YAML <-> corrected-model file (dynamics/corrected_model.hpp), strict like the other
 // parameter readers: unknown keys, non-numbers and invalid values name the file and key. The
-// effects are read and written through the effect table (dynamics/effects.hpp).
+// effects are read and written through the effect table (dynamics/effects.hpp), nominal_params
+// through the nominal model's descriptor, found by name among CorrectedNominalModels.
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -12,8 +13,55 @@
 #include "base/yaml_number.hpp"
 #include "dynamics/corrected_model.hpp"
 #include "dynamics/model_registry.hpp"
+#include "dynamics/with_effects.hpp"  // single_track_core
 
 namespace mppi {
+namespace {
+
+// nominal_params of a model whose data are weights: `network_npz: PATH` (null = the shipped one).
+void read_weights_section(const YAML::Node& node, const std::string& where, std::string& network_npz) {
+  if (!node.IsMap()) throw Error(where + ": expected a map with network_npz");
+  for (const auto& kv : node) {
+    const std::string k = yaml_text(kv.first, "a key", where);
+    if (k != "network_npz")
+      throw Error(yaml_where(where, kv.first.Mark()) + ": unknown key '" + k + "' (valid: network_npz)");
+    network_npz = kv.second.IsNull() ? "" : yaml_text(kv.second, "network_npz", where);
+  }
+}
+
+// nominal_params into `out` for the nominal model D; an empty section keeps the defaults. A
+// parameter table is read from the section's re-emitted `text` (error positions count from the
+// section's first line); a weights section from its `node`.
+template <class D>
+void read_nominal_params(CorrectedModelFile& out, const std::string& text, const YAML::Node& node,
+                         const std::string& where) {
+  if constexpr (HasParamTable<D>) {
+    typename D::Params& p = nominal_params_of<D>(out);
+    if (!text.empty()) p = D::params_from_yaml(text, where);
+    // `nominal` also carries a four-wheel set's single-track core (its mass and geometry).
+    if constexpr (requires { single_track_core(p); }) out.nominal = single_track_core(p);
+  } else if (!text.empty()) {
+    read_weights_section(node, where, out.network_npz);
+  }
+}
+
+// The nominal_params section for the nominal model D: every key of its parameter table (nested
+// two spaces), or the weights file.
+template <class D>
+std::string nominal_params_yaml(const CorrectedModelFile& m) {
+  if constexpr (HasParamTable<D>) {
+    std::istringstream lines(D::params_to_yaml(nominal_params_of<D>(m)));
+    std::string out = "nominal_params:\n";
+    for (std::string line; std::getline(lines, line);)
+      if (!line.empty() && line[0] != '#') out += "  " + line + "\n";
+    return out;
+  } else {
+    return "nominal_params:\n  network_npz: \"" + m.network_npz + "\"\n";
+  }
+}
+
+}  // namespace
+
 CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std::string& source) {
   YAML::Node root;
   try {
@@ -57,26 +105,9 @@ CorrectedModelFile corrected_model_from_yaml(const std::string& text, const std:
     }
   }
   const std::string where = source + " (nominal_params)";
-  if (out.nominal_model == mppi::models::DoubleTrackModel::kName) {
-    if (!nominal_text.empty()) out.double_track = double_track_params_from_yaml(nominal_text, where);
-    out.nominal = out.double_track.base;
-  } else if (out.nominal_model == mppi::models::FullVehicleModel::kName) {
-    if (!nominal_text.empty()) out.full_vehicle = full_vehicle_params_from_yaml(nominal_text, where);
-    out.nominal = out.full_vehicle.base;
-  } else if (out.nominal_model == mppi::models::Kinematic::kName) {
-    if (!nominal_text.empty()) out.kinematic = kinematic_bicycle_params_from_yaml(nominal_text, where);
-  } else if (out.nominal_model == mppi::models::AutoRallyNetworkModel::kName) {
-    if (!nominal_text.empty()) {
-      if (!nominal_node.IsMap()) throw Error(where + ": expected a map with network_npz");
-      for (const auto& kv : nominal_node) {
-        const std::string k = yaml_text(kv.first, "a key", where);
-        if (k != "network_npz") throw Error(yaml_where(where, kv.first.Mark()) + ": unknown key '" + k + "' (valid: network_npz)");
-        out.network_npz = kv.second.IsNull() ? "" : yaml_text(kv.second, "network_npz", where);
-      }
-    }
-  } else if (!nominal_text.empty()) {
-    out.nominal = single_track_params_from_yaml(nominal_text, where);
-  }
+  with_model_in(
+      CorrectedNominalModels{}, out.nominal_model,
+      [&]<class D>() { read_nominal_params<D>(out, nominal_text, nominal_node, where); }, "nominal model");
   std::string why;
   if (!out.effects.is_valid(&why)) throw Error(source + ": effects: " + why);
   return out;
@@ -118,25 +149,9 @@ std::string corrected_model_to_yaml(const CorrectedModelFile& m, const std::stri
     o << "fitted_on:\n";
     for (std::string line; std::getline(fitted_lines, line);) o << "  " << line << "\n";
   }
-  if (m.nominal_model == mppi::models::AutoRallyNetworkModel::kName) {
-    o << "nominal_params:\n  network_npz: \"" << m.network_npz << "\"\n";
-    return o.str();
-  }
-  std::string nominal_yaml;
-  if (m.nominal_model == mppi::models::Kinematic::kName) {
-    KinematicBicycleParams k = m.kinematic;
-    nominal_yaml = write_param_yaml(param_table(k));
-  } else if (m.nominal_model == mppi::models::DoubleTrackModel::kName) {
-    nominal_yaml = to_yaml(m.double_track);
-  } else if (m.nominal_model == mppi::models::FullVehicleModel::kName) {
-    nominal_yaml = to_yaml(m.full_vehicle);
-  } else {
-    nominal_yaml = to_yaml(m.nominal);
-  }
-  std::istringstream lines(nominal_yaml);
-  o << "nominal_params:\n";
-  for (std::string line; std::getline(lines, line);)
-    if (!line.empty() && line[0] != '#') o << "  " << line << "\n";
+  // A nominal model the file cannot name throws here: what was written could not be read back.
+  o << with_model_in(
+      CorrectedNominalModels{}, m.nominal_model, [&]<class D>() { return nominal_params_yaml<D>(m); }, "nominal model");
   return o.str();
 }
 

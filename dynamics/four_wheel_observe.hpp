@@ -33,8 +33,9 @@ inline std::vector<std::string> four_wheel_state_names(std::initializer_list<std
 }
 
 // The descriptor part of a four-wheel model (M::params().base: its single-track parameters).
-template <class M, class P, P (*load_params)(const std::string&)>
-struct FourWheelDescriptor : ParamTableDescriptor<M, P, load_params> {
+template <class M, class P, P (*load_params)(const std::string&),
+          P (*read_params)(const std::string& text, const std::string& source)>
+struct FourWheelDescriptor : ParamTableDescriptor<M, P, load_params, read_params> {
   static void from_plant(const M& m, const float* px, int plant_states, float* mx) {
     four_wheel_from_plant<M>(px, plant_states, static_cast<float>(m.params().base.wheel_radius_m), mx);
   }

@@ -8,8 +8,11 @@
 //   static std::vector<std::string> state_names();  kNx names, the common states first
 //   static void from_plant(const Model&, const float* plant_x, int plant_states, float* x);
 //                                                   its state from a simulated car's state
-// optionally its YAML parameter table
+// optionally its YAML parameter table, and the table as YAML text (strict reading, as a
+// parameter file is read: `source` names the text in errors; writing gives every key)
 //   using Params; static std::vector<ParamField> params(Params&); static Model make(const Params&);
+//   static Params params_from_yaml(const std::string& text, const std::string& source);
+//   static std::string params_to_yaml(const Params&);
 // and optionally a GPU twin (vulkan/): the GLSL file vulkan/shaders/models/<kGpuKernel>.glsl
 // and the floats of the parameter block it reads, named as the GLSL code names them
 //   static constexpr const char* kGpuKernel;
@@ -29,6 +32,7 @@
 
 #include "base/error.hpp"
 #include "base/param_table.hpp"
+#include "base/param_yaml.hpp"
 #include "mppi/concepts.hpp"
 #include "mppi/vehicle_state.hpp"
 
@@ -62,9 +66,11 @@ concept ModelDescriptor =
     };
 
 template <class D>
-concept HasParamTable = requires(typename D::Params& p) {
+concept HasParamTable = requires(typename D::Params& p, const std::string& text) {
   { D::params(p) } -> std::same_as<std::vector<ParamField>>;
   { D::make(p) } -> std::same_as<typename D::Model>;
+  { D::params_from_yaml(text, text) } -> std::same_as<typename D::Params>;
+  { D::params_to_yaml(p) } -> std::same_as<std::string>;
 };
 
 template <class D>
@@ -91,14 +97,24 @@ inline std::vector<std::string> common_state_names_and(std::initializer_list<std
 }
 
 // The descriptor part of a model built from a YAML parameter table P (param_table(P&)): make()
-// from parameters, load() from a file through `load_params` ("" = the built-in defaults).
-template <class M, class P, P (*load_params)(const std::string&)>
+// from parameters, load() from a file through `load_params` ("" = the built-in defaults), the
+// table from YAML text through `read_params` (it names the model in errors and checks the
+// conditions between fields) and back.
+template <class M, class P, P (*load_params)(const std::string&),
+          P (*read_params)(const std::string& text, const std::string& source)>
 struct ParamTableDescriptor {
   using Model = M;
   using Params = P;
   static std::vector<ParamField> params(Params& p) { return param_table(p); }
   static Model make(const Params& p) { return Model(p); }
   static Model load(const std::string& path) { return Model(path.empty() ? Params{} : load_params(path)); }
+  static Params params_from_yaml(const std::string& text, const std::string& source) {
+    return read_params(text, source);
+  }
+  static std::string params_to_yaml(const Params& p) {
+    Params copy = p;  // param_table takes a mutable set: its fields point into it
+    return write_param_yaml(param_table(copy));
+  }
 };
 
 // The descriptor part of a learned model: M::load reads its weights file, which has no built-in

@@ -22,21 +22,28 @@ inline bool is_registered_model(std::string_view name) {
   return visit_by_name(RegisteredModels{}, name, []<class D>() {});
 }
 
-// f.template operator()<Descriptor>() for the model called `name`; returns what f returns.
-// Throws mppi::Error "unknown <what> '<name>' (valid: ...)" for any other name.
-template <class F>
-auto with_model(std::string_view name, F&& f, const char* what = "model") {
+// f.template operator()<Descriptor>() for the model of `List` (RegisteredModels or a part of it)
+// called `name`; returns what f returns. Throws mppi::Error "unknown <what> '<name>' (valid:
+// <the names of List>)" for any other name.
+template <class List, class F>
+auto with_model_in(List list, std::string_view name, F&& f, const char* what = "model") {
   auto unknown = [&] {
-    return Error("unknown " + std::string(what) + " '" + std::string(name) + "' (valid: " + model_names() + ")");
+    return Error("unknown " + std::string(what) + " '" + std::string(name) + "' (valid: " + names_of(list) + ")");
   };
-  using R = decltype(f.template operator()<FrontOf<RegisteredModels>>());
+  using R = decltype(f.template operator()<FrontOf<List>>());
   if constexpr (std::is_void_v<R>) {
-    if (!visit_by_name(RegisteredModels{}, name, f)) throw unknown();
+    if (!visit_by_name(list, name, f)) throw unknown();
   } else {
     std::optional<R> result;
-    if (!visit_by_name(RegisteredModels{}, name, f, result)) throw unknown();
+    if (!visit_by_name(list, name, f, result)) throw unknown();
     return R(std::move(*result));
   }
+}
+
+// The same over every registered model.
+template <class F>
+auto with_model(std::string_view name, F&& f, const char* what = "model") {
+  return with_model_in(RegisteredModels{}, name, std::forward<F>(f), what);
 }
 
 // For --help: every registered model with its summary, default data file, states and (for

@@ -10,7 +10,8 @@
 
 namespace mppi::models {
 
-struct DoubleTrackModel : FourWheelDescriptor<DoubleTrack, DoubleTrackParams, load_double_track_params> {
+struct DoubleTrackModel : FourWheelDescriptor<DoubleTrack, DoubleTrackParams, load_double_track_params,
+                                              double_track_params_from_yaml> {
   static constexpr const char* kName = "double-track";
   static constexpr const char* kSummary = "double-track (four-wheel) physics with lateral load transfer";
   static constexpr const char* kDefaultFile = "config/autorally_double_track.yaml";

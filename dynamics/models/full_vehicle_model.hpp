@@ -11,7 +11,8 @@
 
 namespace mppi::models {
 
-struct FullVehicleModel : FourWheelDescriptor<FullVehicle, FullVehicleParams, load_full_vehicle_params> {
+struct FullVehicleModel : FourWheelDescriptor<FullVehicle, FullVehicleParams, load_full_vehicle_params,
+                                              full_vehicle_params_from_yaml> {
   static constexpr const char* kName = "full-vehicle";
   static constexpr const char* kSummary = "full vehicle: four wheels, sprung mass in heave, roll and pitch, aero drag";
   static constexpr const char* kDefaultFile = "config/autorally_full_vehicle.yaml";

@@ -11,7 +11,8 @@
 
 namespace mppi::models {
 
-struct Kinematic : ParamTableDescriptor<KinematicBicycle, KinematicBicycleParams, load_kinematic_bicycle_params> {
+struct Kinematic : ParamTableDescriptor<KinematicBicycle, KinematicBicycleParams, load_kinematic_bicycle_params,
+                                        kinematic_bicycle_params_from_yaml> {
   static constexpr const char* kName = "kinematic";
   static constexpr const char* kSummary = "kinematic bicycle (no tyre slip), reference point at the rear axle";
   static constexpr const char* kDefaultFile = "";

@@ -11,7 +11,8 @@
 
 namespace mppi::models {
 
-struct SingleTrackModel : ParamTableDescriptor<SingleTrack, SingleTrackParams, load_single_track_params> {
+struct SingleTrackModel : ParamTableDescriptor<SingleTrack, SingleTrackParams, load_single_track_params,
+                                               single_track_params_from_yaml> {
   static constexpr const char* kName = "single-track";
   static constexpr const char* kSummary = "single-track physics: Pacejka tyres, wheel spin, load transfer, DC-motor drive";
   static constexpr const char* kDefaultFile = "config/autorally_single_track.yaml";
