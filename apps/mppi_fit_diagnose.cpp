@@ -144,6 +144,11 @@ int cmd_diagnose(DiagnoseArgs& args) {
   std::printf("selected:");
   for (const auto& s : r.selection.selected) std::printf(" %s", s.c_str());
   std::printf("%s\n", r.selection.selected.empty() ? " (none)" : "");
+  if (!r.selection.partial.empty()) {
+    std::printf("partial correction (not named: a mismatch remains that none explains):");
+    for (const auto& s : r.selection.partial) std::printf(" %s", s.c_str());
+    std::printf("\n");
+  }
   std::printf("verdict: %s\n", r.selection.verdict.c_str());
   std::printf("unexplained mismatch: %s\n", mppi::diagnose::unexplained_summary(r.unexplained).c_str());
   for (const auto& s : r.selection.suspected) std::printf("  suspected %s: %s\n", s.id.c_str(), s.reason.c_str());

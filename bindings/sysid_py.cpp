@@ -317,6 +317,7 @@ py::dict diagnose(const std::string& log, const std::string& params, const std::
                                py::arg("selected") = c.selected, py::arg("round_selected") = c.round_selected));
   py::dict out;
   out["selected"] = r.selection.selected;
+  out["partial"] = r.selection.partial;
   out["final_params"] = params_list(r.selection.final_params);
   out["candidates"] = candidates;
   out["mismatch"] = mismatch;

@@ -87,7 +87,9 @@ void score_heldout(const DiagData& d, const ReplayModel& nominal_model, const Re
 // it is not, any earlier one is removed.
 void write_corrected_model(const DiagData& d, const ModelFamily& nominal, const DiagnoseOptions& o,
                            DiagnoseResult* res) {
-  CorrectedModelFile file = nominal.file(res->selection.final_effects, res->selection.selected);
+  std::vector<std::string> in_model = res->selection.selected;  // named, or a partial correction
+  in_model.insert(in_model.end(), res->selection.partial.begin(), res->selection.partial.end());
+  CorrectedModelFile file = nominal.file(res->selection.final_effects, in_model);
   file.fitted_on = fitted_on_of(d);
   file.fitted_on["heldout"] = o.holdout;
   // The controller has no clock of the recording: a grip change is written as the grip after it.
@@ -174,7 +176,14 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
   // What is left: the corrected model's residuals, located on the held-out part.
   const ResidualSeries rs_after = residual_series(corrected, d, o.locate_horizon_s, o.replay);
   res.remaining = locate(d, rs_after, held);
-  res.unexplained = unexplained_mismatch(res.mismatch, res.remaining, o.unexplained);
+  std::vector<Mismatch> nominal_long;
+  if (o.unexplained.long_horizon_s > 0) {
+    const std::vector<char> all_rows(d.rows(), 1);
+    nominal_long = locate(d, residual_series(nominal_model, d, o.unexplained.long_horizon_s, o.replay), all_rows);
+    res.remaining_long = locate(d, residual_series(corrected, d, o.unexplained.long_horizon_s, o.replay), all_rows);
+  }
+  res.unexplained = unexplained_of_both(res.mismatch, res.remaining, nominal_long, res.remaining_long, o.unexplained);
+  mark_partial_where_unexplained(long_horizon_unexplained(nominal_long, res.remaining_long, o.unexplained), &res.selection);
 
   // 3. Model file.
   write_corrected_model(d, nominal, o, &res);

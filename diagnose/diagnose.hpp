@@ -56,6 +56,8 @@ struct DiagnoseResult {
   // residuals located on the held-out part, strongest first).
   double explained_share[kChannels] = {0, 0, 0};
   std::vector<Mismatch> remaining;
+  // The corrected model's residuals located at UnexplainedOptions::long_horizon_s over all rows.
+  std::vector<Mismatch> remaining_long;
   // Of those, what no named effect explains: clear and not a small remainder (unexplained.hpp).
   std::vector<Mismatch> unexplained;
   // Per held-out recording (DiagnoseOptions::heldout_recordings): normalised RMSE at the

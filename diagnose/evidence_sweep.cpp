@@ -163,6 +163,8 @@ EvidenceRun run_evidence_case(const EvidenceCase& c, const std::string& dir, dou
       run.named_inclusion.push_back(inclusion);
     }
     for (const auto& s : r.selection.suspected) run.suspected.push_back(s.id);
+    run.partial = r.selection.partial;
+    run.unexplained = static_cast<int>(r.unexplained.size());
 
     score_evidence_run(g.place_passes, &run);
 
@@ -193,6 +195,8 @@ std::string evidence_run_json(const EvidenceRun& r) {
   j["named"] = r.named;
   j["named_inclusion"] = r.named_inclusion;
   j["suspected"] = r.suspected;
+  j["partial"] = r.partial;
+  j["unexplained"] = r.unexplained;
   j["acceptable_ids"] = r.acceptable;
   j["out_of_library"] = r.out_of_library;
   j["crossed_once"] = r.crossed_once;
@@ -230,6 +234,8 @@ std::vector<EvidenceRun> read_evidence_runs(const std::string& jsonl_path) {
       r.named = j.at("named").get<std::vector<std::string>>();
       if (j.contains("named_inclusion")) r.named_inclusion = j.at("named_inclusion").get<std::vector<double>>();
       r.suspected = j.at("suspected").get<std::vector<std::string>>();
+      if (j.contains("partial")) r.partial = j.at("partial").get<std::vector<std::string>>();
+      if (j.contains("unexplained")) r.unexplained = j.at("unexplained").get<int>();
       r.acceptable = j.at("acceptable_ids").get<std::vector<std::string>>();
       r.out_of_library = j.at("out_of_library");
       r.right = j.at("right");

@@ -130,6 +130,9 @@ struct SuspectedEffect {
 
 struct Selection {
   std::vector<std::string> selected;            // named, in the order chosen
+  // Chosen but not named: they explain a mismatch only in part, and a part no candidate explains
+  // remains (unexplained.hpp). They are in final_effects and the model file.
+  std::vector<std::string> partial;
   std::vector<CandidateReport> candidates;      // every candidate considered
   std::vector<SuspectedEffect> suspected;       // "suspected, not identifiable from this recording"
   std::vector<ParamEstimate> final_params;      // joint refit of the selected effects

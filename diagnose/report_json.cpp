@@ -144,6 +144,7 @@ nlohmann::ordered_json report_json(const DiagData& d, const std::string& nominal
   j["holdout"] = o.holdout;
   j["screening"] = screening_json(d);
   j["selected"] = res.selection.selected;
+  j["partial"] = res.selection.partial;
   j["reliable"] = res.selection.reliable;
   j["verdict"] = res.selection.verdict;
   j["sensor_faults"] = sensor_faults_json(res.selection);
@@ -173,6 +174,7 @@ nlohmann::ordered_json report_json(const DiagData& d, const std::string& nominal
                          : validation_headline;
   for (int c = 0; c < kChannels; ++c) j["explained_share"][kChannelNames[c]] = num(res.explained_share[c]);
   j["remaining"] = mismatch_json(res.remaining);
+  j["remaining_long_horizon"] = mismatch_json(res.remaining_long);
   j["unexplained"] = mismatch_json(res.unexplained);
   j["per_recording"] = per_recording_json(res.per_recording);
   if (o.test) j["test"] = test_json(o, res);

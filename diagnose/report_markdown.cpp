@@ -17,8 +17,13 @@ void write_summary(std::ostream& md, const DiagData& d, const std::string& nomin
      << (o.params_source.empty() ? " (library defaults)" : " from `" + o.params_source + "`")
      << "\n- corrected model: " << (res.model_file.empty() ? std::string("none written") : "`" + res.model_file + "`")
      << "\n- verdict: **" << res.selection.verdict << "**\n"
-     << "- unexplained mismatch (clear in the corrected model's held-out residual, no named effect explains it): "
+     << "- unexplained mismatch (clear in the corrected model's residual, no named effect explains it): "
      << unexplained_summary(res.unexplained) << "\n";
+  if (!res.selection.partial.empty()) {
+    md << "- partial correction (in the model file; not named, since the mismatch above remains):";
+    for (const auto& id : res.selection.partial) md << " " << id;
+    md << "\n";
+  }
   // The figure a user should trust first: on data that neither the fit nor the veto saw.
   if (o.test)
     md << "- **headline (test data, never seen by the fit or the validation):** normalised RMSE at "

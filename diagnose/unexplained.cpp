@@ -6,6 +6,14 @@
 
 namespace mppi::diagnose {
 
+namespace {
+std::string horizon_text(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g-s", s);
+  return buf;
+}
+}  // namespace
+
 std::vector<Mismatch> unexplained_mismatch(const std::vector<Mismatch>& nominal, const std::vector<Mismatch>& remaining,
                                            const UnexplainedOptions& o) {
   auto largest_nominal = [&](const std::string& channel) {
@@ -24,6 +32,39 @@ std::vector<Mismatch> unexplained_mismatch(const std::vector<Mismatch>& nominal,
   std::stable_sort(out.begin(), out.end(), [](const Mismatch& a, const Mismatch& b) { return std::abs(a.z) > std::abs(b.z); });
   if (out.size() > static_cast<std::size_t>(std::max(0, o.max_listed))) out.resize(static_cast<std::size_t>(std::max(0, o.max_listed)));
   return out;
+}
+
+std::vector<Mismatch> long_horizon_unexplained(const std::vector<Mismatch>& nominal_long,
+                                               const std::vector<Mismatch>& remaining_long, const UnexplainedOptions& o) {
+  UnexplainedOptions all = o;
+  all.max_listed = static_cast<int>(remaining_long.size());
+  std::vector<Mismatch> out = unexplained_mismatch(nominal_long, remaining_long, all);
+  for (Mismatch& m : out) m.where += " (" + horizon_text(o.long_horizon_s) + " predictions, all rows)";
+  return out;
+}
+
+std::vector<Mismatch> unexplained_of_both(const std::vector<Mismatch>& nominal_short, const std::vector<Mismatch>& remaining_short,
+                                          const std::vector<Mismatch>& nominal_long, const std::vector<Mismatch>& remaining_long,
+                                          const UnexplainedOptions& o) {
+  UnexplainedOptions all = o;
+  all.max_listed = static_cast<int>(remaining_short.size());
+  std::vector<Mismatch> out = unexplained_mismatch(nominal_short, remaining_short, all);
+  for (Mismatch& m : long_horizon_unexplained(nominal_long, remaining_long, o)) out.push_back(std::move(m));
+  std::stable_sort(out.begin(), out.end(), [](const Mismatch& a, const Mismatch& b) { return std::abs(a.z) > std::abs(b.z); });
+  if (out.size() > static_cast<std::size_t>(std::max(0, o.max_listed))) out.resize(static_cast<std::size_t>(std::max(0, o.max_listed)));
+  return out;
+}
+
+void mark_partial_where_unexplained(const std::vector<Mismatch>& long_look, Selection* selection) {
+  if (long_look.empty() || selection->selected.empty()) return;
+  selection->partial = selection->selected;
+  selection->selected.clear();
+  std::string ids;
+  for (const std::string& id : selection->partial) ids += (ids.empty() ? "" : ", ") + id;
+  selection->verdict = "unexplained mismatch (" + long_look.front().channel + ", " + long_look.front().where +
+                       "); partial correction: " + ids;
+  selection->log.push_back("an unexplained mismatch remains (" + unexplained_summary({long_look.front()}) +
+                           "): " + ids + " explain it in part and are not named");
 }
 
 std::string unexplained_summary(const std::vector<Mismatch>& unexplained) {

@@ -5,9 +5,13 @@
 // where the data resolve it clearly and it is not a small remainder of a mismatch the correction
 // took away: the library holds no term that explains it (or none was among the candidates), and
 // the report says where it sits and how large it is instead of leaving it to the nearest name.
+// Where a mismatch stays unexplained, the effects the selection chose explain it only in part:
+// they are reported as a partial correction (they improve the prediction and are written to the
+// model file), not as the physics that was missing.
 #include <string>
 #include <vector>
 
+#include "diagnose/fit.hpp"
 #include "diagnose/locate.hpp"
 
 namespace mppi::diagnose {
@@ -22,12 +26,38 @@ struct UnexplainedOptions {
   double min_share_of_nominal = 0.2;
   // At most this many are reported (strongest first); the rest are in the remaining list.
   int max_listed = 3;
+  // A second look at a longer horizon, over all rows (fitted and held out): a term that only
+  // mimics the missing one takes most of the short predictions' error away but leaves a drift
+  // that builds over a second; the longer horizon shows the drift with less of the sensor noise,
+  // and all rows resolve it. The correction has a few parameters, so the rows it was fitted on
+  // hide little of what its form cannot follow. 0 = no second look.
+  double long_horizon_s = 1.0;
 };
 
 // The remaining findings (the corrected model's, held out) that are unexplained, strongest first.
 // `nominal`: the nominal model's findings (their sizes per channel are the reference).
 std::vector<Mismatch> unexplained_mismatch(const std::vector<Mismatch>& nominal, const std::vector<Mismatch>& remaining,
                                            const UnexplainedOptions& o = {});
+
+// The long look's unexplained findings (its nominal findings at the same horizon and rows as the
+// reference), each marked "(<horizon>-s predictions, all rows)".
+std::vector<Mismatch> long_horizon_unexplained(const std::vector<Mismatch>& nominal_long,
+                                               const std::vector<Mismatch>& remaining_long, const UnexplainedOptions& o = {});
+
+// The two looks joined, strongest first, at most o.max_listed: the short look's findings judged
+// against the nominal model's located mismatch (training rows, as the diagnosis locates it), the
+// long look's as long_horizon_unexplained.
+std::vector<Mismatch> unexplained_of_both(const std::vector<Mismatch>& nominal_short, const std::vector<Mismatch>& remaining_short,
+                                          const std::vector<Mismatch>& nominal_long, const std::vector<Mismatch>& remaining_long,
+                                          const UnexplainedOptions& o = {});
+
+// Where the long look leaves an unexplained mismatch (`long_look`: long_horizon_unexplained), the
+// selection's named effects become its partial correction (Selection::partial) and the verdict
+// says so; else the selection is left as it is. The short look's findings do not demote: on the
+// held-out part at 0.2 s a right correction can still leave a place or a moment it does not reach
+// (the steering's end stop, a window of time), whereas what a mimic leaves is a drift that builds
+// over the longer horizon wherever the car drives.
+void mark_partial_where_unexplained(const std::vector<Mismatch>& long_look, Selection* selection);
 
 // One line: "vx, overall: -0.189 m/s^2 (z -6.7); ..." ("none" for an empty list).
 std::string unexplained_summary(const std::vector<Mismatch>& unexplained);

@@ -23,14 +23,18 @@ enum class EffectHook {
   kSensor,    // changes what the recording shows (measured states, time stamps), not the car
 };
 
-struct EffectParamSpec {
+// One parameter of an effect, a member of Owner: EffectParams in the effect table, the effect's own
+// parameter struct in a file of its own (EffectParams derives from it).
+template <class Owner>
+struct BasicEffectParamSpec {
   const char* name;             // key in the corrected-model file (EffectParams field)
-  double EffectParams::*member;
+  double Owner::*member;
   const char* unit;
   Range valid;                  // values a model accepts (is_valid)
   double lo, hi;                // range a fit searches (fits are projected onto it)
   double scale;                 // typical size: finite-difference step = 0.01 scale
 };
+using EffectParamSpec = BasicEffectParamSpec<EffectParams>;
 
 // What a recording must contain for an effect to be identifiable from it (the diagnosis
 // measures it on the data; diagnose/identifiability.hpp).
@@ -56,11 +60,13 @@ enum class DataGrid {
 };
 inline int grid_param_count(DataGrid g) { return g == DataGrid::kTime ? 1 : g == DataGrid::kPlace ? 2 : 0; }
 
-struct EffectSpec {
+// An effect; Owner holds its parameters (as for BasicEffectParamSpec).
+template <class Owner>
+struct BasicEffectSpec {
   std::string id;               // effect id, e.g. "steer_delay"
   std::string description;      // one line, physical meaning
   EffectHook hook;
-  std::vector<EffectParamSpec> params;
+  std::vector<BasicEffectParamSpec<Owner>> params;
   std::vector<double> grid;     // start values searched for params[0] (empty: its default)
   DataGrid data_grid = DataGrid::kNone;  // leading params searched over the data (not LM-fitted)
   Excitation needs = Excitation::kAny;
@@ -74,31 +80,12 @@ struct EffectSpec {
   // In the diagnosis' default candidate library (false: a candidate only where asked for by name).
   bool default_candidate = true;
 };
+using EffectSpec = BasicEffectSpec<EffectParams>;
 
-// The declaration of an effect in a file of its own: an EffectSpec whose parameters are members
-// of the effect's own parameter struct P (EffectParams derives from P).
+// The declaration of an effect in a file of its own: its spec over the members of its own
+// parameter struct P; the effect table converts it (effect_spec_of, dynamics/effects.hpp).
 template <class P>
-struct EffectParamDecl {
-  const char* name;
-  double P::*member;
-  const char* unit;
-  Range valid;
-  double lo, hi;
-  double scale;
-};
-template <class P>
-struct EffectDecl {
-  std::string id;
-  std::string description;
-  EffectHook hook;
-  std::vector<EffectParamDecl<P>> params;
-  std::vector<double> grid = {};
-  DataGrid data_grid = DataGrid::kNone;
-  Excitation needs = Excitation::kAny;
-  std::string dynamics_of = {};
-  std::string partner = {};
-  bool default_candidate = true;
-};
+using EffectDecl = BasicEffectSpec<P>;
 
 // Body-axis accelerations of a step, per lane, as an effect's force term sees and adds to them:
 // the start-of-step velocities and applied steer (normalised), and the sums it adds to.

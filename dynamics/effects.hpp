@@ -152,7 +152,7 @@ struct EffectParams : effects::ParamsOfAll<effects::DeclaredEffects> {
 // An effect declared in a file of its own as an EffectSpec of the table.
 template <class E>
 EffectSpec effect_spec_of() {
-  const EffectDecl<typename E::Params> d = E::decl();
+  const EffectDecl<typename E::Params> d = E::decl();  // the same fields over E's own parameters
   EffectSpec spec{d.id, d.description, d.hook, {}, d.grid, d.data_grid, d.needs, d.dynamics_of, d.partner,
                   d.default_candidate};
   for (const auto& p : d.params)

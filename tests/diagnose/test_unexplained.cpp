@@ -42,6 +42,37 @@ TEST_CASE("unexplained: clear findings that are not a small remainder of the nom
   CHECK(mppi::diagnose::unexplained_summary(u).find("yaw_rate, overall: -0.06 m/s^2 (z -12.0)") == 0);
 }
 
+TEST_CASE("unexplained: the long look joins the short one, each judged against its own nominal findings", "[diagnose]") {
+  const std::vector<Mismatch> nominal_short = {finding("vx", "overall", -0.5, -9.0)};
+  const std::vector<Mismatch> remaining_short = {finding("vx", "overall", -0.05, -6.0)};  // a tenth: a remainder
+  const std::vector<Mismatch> nominal_long = {finding("vx", "throttle in [0.4, 0.9] 1", 0.3, 12.0)};
+  const std::vector<Mismatch> remaining_long = {finding("vx", "throttle in [0.4, 0.9] 1", 0.1, 7.0),  // a third: kept
+                                                finding("yaw_rate", "overall", 0.02, 4.5)};         // not clear
+  const auto u = mppi::diagnose::unexplained_of_both(nominal_short, remaining_short, nominal_long, remaining_long);
+  REQUIRE(u.size() == 1);
+  CHECK(u[0].where == "throttle in [0.4, 0.9] 1 (1-s predictions, all rows)");
+  const auto long_look = mppi::diagnose::long_horizon_unexplained(nominal_long, remaining_long);
+  REQUIRE(long_look.size() == 1);
+  CHECK(long_look[0].where == u[0].where);
+  // The same short remainder beside a smaller nominal mismatch (0.2: a fourth of it) is kept.
+  CHECK(mppi::diagnose::unexplained_of_both({finding("vx", "overall", -0.2, -9.0)}, remaining_short, {}, {}).size() == 1);
+}
+
+TEST_CASE("unexplained: the named effects become a partial correction only where a mismatch remains", "[diagnose]") {
+  mppi::diagnose::Selection s;
+  s.selected = {"throttle_gain", "throttle_offset"};
+  s.verdict = "named: throttle_gain, throttle_offset";
+  mppi::diagnose::mark_partial_where_unexplained({}, &s);
+  CHECK(s.selected.size() == 2);
+  CHECK(s.partial.empty());
+  mppi::diagnose::mark_partial_where_unexplained({finding("vx", "speed in [4, 8] m/s", 0.2, 7.3)}, &s);
+  CHECK(s.selected.empty());
+  CHECK(s.partial == std::vector<std::string>{"throttle_gain", "throttle_offset"});
+  CHECK(s.verdict == "unexplained mismatch (vx, speed in [4, 8] m/s); partial correction: throttle_gain, throttle_offset");
+  REQUIRE_FALSE(s.log.empty());
+  CHECK(s.log.back().find("explain it in part") != std::string::npos);
+}
+
 // The independent generator's payload (evidence/: its own car physics): offered only terms that
 // cannot explain a heavier car, the diagnosis reports the mismatch it leaves as unexplained; with
 // the payload among the candidates it names it, and nothing clear is left.
@@ -55,6 +86,7 @@ TEST_CASE("unexplained: a payload the candidates cannot explain is reported, and
   INFO("without: named " << mppi::test::joined(r_without.selection.selected) << "; unexplained "
                          << mppi::diagnose::unexplained_summary(r_without.unexplained));
   CHECK_FALSE(r_without.unexplained.empty());
+  CHECK(r_without.selection.selected.empty());  // what it chose is at most a partial correction
   mppi::diagnose::DiagnoseOptions with = without;
   with.selection.candidates.push_back("payload");
   const auto r_with = mppi::test::diagnose_independent(rec, with);
