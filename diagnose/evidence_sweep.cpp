@@ -259,6 +259,7 @@ namespace {
 struct Totals {
   int with_effect = 0, right = 0, right_strict = 0, crossed_once = 0, wrong = 0, worse = 0, clean_runs = 0,
       clean_named = 0, errors = 0;
+  int unexplained = 0, partial = 0;  // runs with an effect that report an unexplained mismatch / a partial correction
   std::vector<double> reductions;
 };
 
@@ -280,6 +281,8 @@ Totals totals_of(const std::vector<EvidenceRun>& runs) {
     t.right_strict += r.right_strict;
     t.crossed_once += !r.crossed_once.empty();
     t.wrong += r.wrong;
+    t.unexplained += r.unexplained > 0;
+    t.partial += !r.partial.empty();
     if (!r.out_of_library) t.reductions.push_back(r.reduction());
   }
   return t;
@@ -332,7 +335,10 @@ std::string evidence_summary_markdown(const std::vector<EvidenceRun>& runs) {
      << "| something named on effect-free recordings | 0 | " << t.clean_named << "/" << t.clean_runs << " |\n"
      << "| corrected worse than nominal on held-out data (noise-free states) | 0 runs | " << t.worse << "/"
      << (t.with_effect + t.clean_runs) << " |\n"
-     << "| median held-out 1-s RMSE reduction (noise-free states, in-library effects) | >= 50 % | " << b << " |\n";
+     << "| median held-out 1-s RMSE reduction (noise-free states, in-library effects) | >= 50 % | " << b << " |\n"
+     << "| an unexplained mismatch reported (with an effect) | - | " << pct(t.unexplained, t.with_effect) << " |\n"
+     << "| a partial correction instead of names (with an effect; not counted as named) | - | "
+     << pct(t.partial, t.with_effect) << " |\n";
   if (t.errors) md << "\n" << t.errors << " run(s) failed (see the JSON lines' `error`).\n";
   return md.str();
 }
@@ -351,6 +357,8 @@ std::string evidence_summary_json(const std::vector<EvidenceRun>& runs) {
   j["effect_free_named"] = t.clean_named;
   j["corrected_worse_than_nominal"] = t.worse;
   j["median_heldout_1s_rmse_reduction_clean"] = median(t.reductions);
+  j["unexplained_reported"] = t.unexplained;
+  j["partial_correction"] = t.partial;
   j["errors"] = t.errors;
   nlohmann::ordered_json all = nlohmann::ordered_json::array();
   for (const auto& r : runs) all.push_back(nlohmann::ordered_json::parse(evidence_run_json(r)));
