@@ -55,12 +55,7 @@ std::vector<Mismatch> unexplained_of_both(const std::vector<Mismatch>& nominal_s
   return out;
 }
 
-void mark_partial_where_unexplained(const std::vector<Mismatch>& nominal_long, const std::vector<Mismatch>& all_long_look,
-                                    Selection* selection) {
-  std::vector<Mismatch> long_look;  // remainders: in a channel where the nominal model had a finding
-  for (const Mismatch& m : all_long_look)
-    if (std::any_of(nominal_long.begin(), nominal_long.end(), [&](const Mismatch& n) { return n.channel == m.channel; }))
-      long_look.push_back(m);
+void mark_partial_where_unexplained(const std::vector<Mismatch>& long_look, Selection* selection) {
   if (long_look.empty() || selection->selected.empty()) return;
   selection->partial = selection->selected;
   selection->selected.clear();

@@ -51,17 +51,17 @@ std::vector<Mismatch> unexplained_of_both(const std::vector<Mismatch>& nominal_s
                                           const std::vector<Mismatch>& nominal_long, const std::vector<Mismatch>& remaining_long,
                                           const UnexplainedOptions& o = {});
 
-// Where the long look leaves an unexplained mismatch in a channel where the nominal model had one
-// too (`long_look`: long_horizon_unexplained; `nominal_long`: the nominal model's long-look
-// findings), the selection's named effects become its partial correction (Selection::partial)
-// and the verdict says so; else the selection is left as it is.
+// Where the long look leaves an unexplained mismatch (`long_look`: long_horizon_unexplained), the
+// selection's named effects become its partial correction (Selection::partial) and the verdict
+// says so; else the selection is left as it is.
 // - The short look's findings do not demote: on the held-out part at 0.2 s a right correction can
 //   still leave a place or a moment it does not reach (the steering's end stop, a window of time),
-//   whereas what a mimic leaves is a drift that builds over the longer horizon wherever the car drives.
-// - A finding in a channel the nominal model got right is the correction's own doing (a term it
-//   should not hold), not a remainder that a mimic left: it is reported, and does not demote.
-void mark_partial_where_unexplained(const std::vector<Mismatch>& nominal_long, const std::vector<Mismatch>& long_look,
-                                    Selection* selection);
+//   whereas what a mimic leaves is a drift that builds over the longer horizon.
+// - A long-look finding in a channel the nominal model got right demotes too: a term that mimics
+//   the missing one in one regime distorts another (a weaker motor for a heavier car accelerates
+//   the car wrongly where the nominal model was right on average), and a term the data do not
+//   hold leaves its mark where it acts. Either way the names are not the whole story.
+void mark_partial_where_unexplained(const std::vector<Mismatch>& long_look, Selection* selection);
 
 // One line: "vx, overall: -0.189 m/s^2 (z -6.7); ..." ("none" for an empty list).
 std::string unexplained_summary(const std::vector<Mismatch>& unexplained);
