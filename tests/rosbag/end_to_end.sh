@@ -1,7 +1,8 @@
 #!/bin/bash
 # A simulated drive as a rosbag: mppi-sim drives 20 s, scripts/log_to_bag.py writes its log as
-# AutoRally's topics (python3-rosbag), and `mppi-fit diagnose --log drive.bag` must name the same
-# effects, with the same held-out reduction, as the diagnosis of the log itself.
+# AutoRally's topics (python3-rosbag), and `mppi-fit diagnose --log drive.bag` must choose the same
+# effects (named or as a partial correction), with the same held-out reduction, as the diagnosis of
+# the log itself.
 #   end_to_end.sh BIN_DIR SOURCE_DIR
 set -euo pipefail
 bin=$1
@@ -32,6 +33,9 @@ for key in "selected:" "verdict:" "held-out normalised RMSE"; do
     status=1
   fi
 done
-grep -q "^verdict: named:" "$work/log.txt" || { echo "FAIL: the log's diagnosis names no effect"; status=1; }
+# Effects chosen: named, or a partial correction beside an unexplained mismatch (the simulator's
+# plant is not the diagnosis' nominal model, so part of the mismatch may have no term).
+grep -qE "^verdict: (named:|unexplained mismatch .*; partial correction:)" "$work/log.txt" ||
+  { echo "FAIL: the log's diagnosis chooses no effect"; status=1; }
 [ $status -eq 0 ] && echo PASS
 exit $status
