@@ -182,8 +182,9 @@ DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, cons
     nominal_long = locate(d, residual_series(nominal_model, d, o.unexplained.long_horizon_s, o.replay), all_rows);
     res.remaining_long = locate(d, residual_series(corrected, d, o.unexplained.long_horizon_s, o.replay), all_rows);
   }
-  res.unexplained = unexplained_of_both(res.mismatch, res.remaining, nominal_long, res.remaining_long, o.unexplained);
-  mark_partial_where_unexplained(long_horizon_unexplained(nominal_long, res.remaining_long, o.unexplained), &res.selection);
+  const std::vector<Mismatch> long_look = long_horizon_unexplained(nominal_long, res.remaining_long, o.unexplained);
+  res.unexplained = unexplained_of_both(res.mismatch, res.remaining, long_look, o.unexplained);
+  mark_partial_where_unexplained(long_look, &res.selection);
 
   // 3. Model file.
   write_corrected_model(d, nominal, o, &res);

@@ -12,6 +12,15 @@ std::string horizon_text(double s) {
   std::snprintf(buf, sizeof buf, "%g-s", s);
   return buf;
 }
+
+// Strongest (largest |z|) first, at most max_listed.
+std::vector<Mismatch> strongest_first(std::vector<Mismatch> findings, int max_listed) {
+  std::stable_sort(findings.begin(), findings.end(),
+                   [](const Mismatch& a, const Mismatch& b) { return std::abs(a.z) > std::abs(b.z); });
+  if (findings.size() > static_cast<std::size_t>(std::max(0, max_listed)))
+    findings.resize(static_cast<std::size_t>(std::max(0, max_listed)));
+  return findings;
+}
 }  // namespace
 
 std::vector<Mismatch> unexplained_mismatch(const std::vector<Mismatch>& nominal, const std::vector<Mismatch>& remaining,
@@ -29,9 +38,7 @@ std::vector<Mismatch> unexplained_mismatch(const std::vector<Mismatch>& nominal,
     if (std::abs(m.magnitude) < o.min_share_of_nominal * largest_nominal(m.channel)) continue;
     out.push_back(m);
   }
-  std::stable_sort(out.begin(), out.end(), [](const Mismatch& a, const Mismatch& b) { return std::abs(a.z) > std::abs(b.z); });
-  if (out.size() > static_cast<std::size_t>(std::max(0, o.max_listed))) out.resize(static_cast<std::size_t>(std::max(0, o.max_listed)));
-  return out;
+  return strongest_first(std::move(out), o.max_listed);
 }
 
 std::vector<Mismatch> long_horizon_unexplained(const std::vector<Mismatch>& nominal_long,
@@ -44,15 +51,12 @@ std::vector<Mismatch> long_horizon_unexplained(const std::vector<Mismatch>& nomi
 }
 
 std::vector<Mismatch> unexplained_of_both(const std::vector<Mismatch>& nominal_short, const std::vector<Mismatch>& remaining_short,
-                                          const std::vector<Mismatch>& nominal_long, const std::vector<Mismatch>& remaining_long,
-                                          const UnexplainedOptions& o) {
+                                          std::vector<Mismatch> long_look, const UnexplainedOptions& o) {
   UnexplainedOptions all = o;
   all.max_listed = static_cast<int>(remaining_short.size());
   std::vector<Mismatch> out = unexplained_mismatch(nominal_short, remaining_short, all);
-  for (Mismatch& m : long_horizon_unexplained(nominal_long, remaining_long, o)) out.push_back(std::move(m));
-  std::stable_sort(out.begin(), out.end(), [](const Mismatch& a, const Mismatch& b) { return std::abs(a.z) > std::abs(b.z); });
-  if (out.size() > static_cast<std::size_t>(std::max(0, o.max_listed))) out.resize(static_cast<std::size_t>(std::max(0, o.max_listed)));
-  return out;
+  for (Mismatch& m : long_look) out.push_back(std::move(m));
+  return strongest_first(std::move(out), o.max_listed);
 }
 
 void mark_partial_where_unexplained(const std::vector<Mismatch>& long_look, Selection* selection) {

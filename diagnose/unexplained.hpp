@@ -45,11 +45,10 @@ std::vector<Mismatch> long_horizon_unexplained(const std::vector<Mismatch>& nomi
                                                const std::vector<Mismatch>& remaining_long, const UnexplainedOptions& o = {});
 
 // The two looks joined, strongest first, at most o.max_listed: the short look's findings judged
-// against the nominal model's located mismatch (training rows, as the diagnosis locates it), the
-// long look's as long_horizon_unexplained.
+// against the nominal model's located mismatch (training rows, as the diagnosis locates it), and
+// the long look's unexplained findings (`long_look`: long_horizon_unexplained).
 std::vector<Mismatch> unexplained_of_both(const std::vector<Mismatch>& nominal_short, const std::vector<Mismatch>& remaining_short,
-                                          const std::vector<Mismatch>& nominal_long, const std::vector<Mismatch>& remaining_long,
-                                          const UnexplainedOptions& o = {});
+                                          std::vector<Mismatch> long_look, const UnexplainedOptions& o = {});
 
 // Where the long look leaves an unexplained mismatch (`long_look`: long_horizon_unexplained), the
 // selection's named effects become its partial correction (Selection::partial) and the verdict

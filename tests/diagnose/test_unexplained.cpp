@@ -48,14 +48,15 @@ TEST_CASE("unexplained: the long look joins the short one, each judged against i
   const std::vector<Mismatch> nominal_long = {finding("vx", "throttle in [0.4, 0.9] 1", 0.3, 12.0)};
   const std::vector<Mismatch> remaining_long = {finding("vx", "throttle in [0.4, 0.9] 1", 0.1, 7.0),  // a third: kept
                                                 finding("yaw_rate", "overall", 0.02, 4.5)};         // not clear
-  const auto u = mppi::diagnose::unexplained_of_both(nominal_short, remaining_short, nominal_long, remaining_long);
+  const auto u = mppi::diagnose::unexplained_of_both(
+      nominal_short, remaining_short, mppi::diagnose::long_horizon_unexplained(nominal_long, remaining_long));
   REQUIRE(u.size() == 1);
   CHECK(u[0].where == "throttle in [0.4, 0.9] 1 (1-s predictions, all rows)");
   const auto long_look = mppi::diagnose::long_horizon_unexplained(nominal_long, remaining_long);
   REQUIRE(long_look.size() == 1);
   CHECK(long_look[0].where == u[0].where);
   // The same short remainder beside a smaller nominal mismatch (0.2: a fourth of it) is kept.
-  CHECK(mppi::diagnose::unexplained_of_both({finding("vx", "overall", -0.2, -9.0)}, remaining_short, {}, {}).size() == 1);
+  CHECK(mppi::diagnose::unexplained_of_both({finding("vx", "overall", -0.2, -9.0)}, remaining_short, {}).size() == 1);
 }
 
 TEST_CASE("unexplained: the named effects become a partial correction only where a mismatch remains", "[diagnose]") {
