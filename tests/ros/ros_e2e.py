@@ -234,14 +234,25 @@ def run_launch(bin_dir, scratch):
                                             method='POST', headers={'X-MPPI-Token': token.group(1)})
                 with urllib.request.urlopen(req, timeout=5) as r:
                     return r.status
-            page_runstop = 'POST runstop=1 answered %s' % control('runstop=1')
-            for _ in range(5):
-                status = subprocess.run(['rostopic', 'echo', '-n', '1', '/pathIntegralStatus/info'], env=env,
-                                        capture_output=True, text=True, timeout=15).stdout
-                if 'operator page' in status:
-                    page_runstop = 'status: ' + status.split('\n')[0]
-                    break
-            control('runstop=0')
+            # The runstop is held only until the status says so: a safe stop coasts with the wheels
+            # straight, and a long one in a corner leaves the road whatever the controller does.
+            echo_log = os.path.join(scratch, 'status_echo.log')
+            watcher = start(['rostopic', 'echo', '/pathIntegralStatus/info'], dict(env, PYTHONUNBUFFERED='1'), echo_log)
+            try:
+                connect_deadline = time.time() + 15  # the subscriber hears a status (one per 0.1 s)
+                while time.time() < connect_deadline and os.path.getsize(echo_log) == 0:
+                    time.sleep(0.05)
+                page_runstop = 'POST runstop=1 answered %s' % control('runstop=1')
+                runstop_deadline = time.time() + 10
+                while time.time() < runstop_deadline and 'operator page' not in page_runstop:
+                    time.sleep(0.05)
+                    with open(echo_log) as f:
+                        said = [line for line in f if 'operator page' in line]
+                    if said:
+                        page_runstop = 'status: ' + said[0].strip()
+                control('runstop=0')
+            finally:
+                stop(watcher, 5)
         proc.wait(timeout=60)
     except subprocess.TimeoutExpired:
         pass
@@ -255,7 +266,13 @@ def run_launch(bin_dir, scratch):
           (', '.join('%.2f' % t for t in got['lap_times_s']), got['crashes']))
     failures = []
     if got['laps'] != 1 or got['crashes'] != 0:
-        failures.append('%d laps, %d crashes (want 1 lap, no crash)' % (got['laps'], got['crashes']))
+        failures.append('%d laps, %d crashes (want 1 lap, no crash): %s' %
+                        (got['laps'], got['crashes'], '; '.join(got.get('crash_reasons', []))))
+    if os.path.exists(stats_file):
+        with open(stats_file) as f:
+            stats = json.load(f)
+        print('controller: %d commands, optimizer p50 %s ms, p99 %s ms, %d safe stops' %
+              (stats['commands'], stats['optimizer_ms']['p50'], stats['optimizer_ms']['p99'], stats['safe_stops']))
     if gains is None:
         failures.append('no feedbackGains from the tube controller')
     else:
