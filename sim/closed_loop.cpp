@@ -11,6 +11,7 @@
 #include <numbers>
 #include <memory>
 #include <optional>
+#include <type_traits>
 #include <vector>
 
 #include "chassis/sim_adapter.hpp"
@@ -537,7 +538,13 @@ RunSummary run_closed_loop(const ClosedLoopConfig& given) {
                   ": times must be finite and ascending, speeds finite");
   }
   if (!config.surface_yaml.empty()) {
-    if (config.plant != models::SingleTrackModel::kName)
+    // The surface plant is the single-track car on the map: a plant whose parameters are
+    // SingleTrackParams themselves.
+    const bool single_track_params = is_registered_model(config.plant) && with_model(config.plant, [&]<class D>() {
+      if constexpr (HasParamTable<D>) return std::is_same_v<typename D::Params, SingleTrackParams>;
+      else return false;
+    }, "plant");
+    if (!single_track_params)
       throw Error("a surface map (" + config.surface_yaml + ") needs the single-track plant, not '" + config.plant + "'");
     auto surface = std::make_shared<const SurfaceMap>(SurfaceMap::load(config.surface_yaml));
     const SingleTrackParams params =

@@ -1,9 +1,15 @@
 #include "sim/corrected_limit_vehicle.hpp"
 
+#include <type_traits>
+
 namespace mppi::sim {
 
 std::optional<SingleTrackParams> corrected_limit_lap_vehicle(const CorrectedModelFile& file) {
-  if (file.nominal_model != models::SingleTrackModel::kName) return std::nullopt;
+  bool single_track_params = false;  // the nominal's parameters are SingleTrackParams themselves
+  visit_by_name(CorrectedNominalModels{}, file.nominal_model, [&]<class D>() {
+    if constexpr (HasParamTable<D>) single_track_params = std::is_same_v<typename D::Params, SingleTrackParams>;
+  });
+  if (!single_track_params) return std::nullopt;
   EffectParams car_effects;  // only the effects named in the header; the rest stay at "off"
   car_effects.mass_scale = file.effects.mass_scale;
   car_effects.yaw_inertia_scale = file.effects.yaw_inertia_scale;

@@ -227,6 +227,8 @@ TEST_CASE("closed loop on a surface map: drives, logs the surface, refuses plant
   CHECK(s.mean_speed_mps > 0.5);
   const Recording rec = RecordingReader::read(c.out_dir + "/log.csv");
   CHECK(rec.metadata.at("surface") == c.surface_yaml);
-  c.plant = "kinematic";
-  CHECK_THROWS_WITH(run_closed_loop(c), Catch::Contains("needs the single-track plant"));
+  for (const char* plant : {"kinematic", "double-track", "no-such-plant"}) {
+    c.plant = plant;
+    CHECK_THROWS_WITH(run_closed_loop(c), Catch::Contains("needs the single-track plant, not '" + std::string(plant)));
+  }
 }
