@@ -145,7 +145,8 @@ int cmd_diagnose(DiagnoseArgs& args) {
   for (const auto& s : r.selection.selected) std::printf(" %s", s.c_str());
   std::printf("%s\n", r.selection.selected.empty() ? " (none)" : "");
   if (!r.selection.partial.empty()) {
-    std::printf("partial correction (not named: a mismatch remains that none explains):");
+    std::printf("partial correction (not named: a mismatch remains that none explains%s%s):",
+                r.selection.ambiguous.empty() ? "" : ", or ambiguous: ", r.selection.ambiguous.c_str());
     for (const auto& s : r.selection.partial) std::printf(" %s", s.c_str());
     std::printf("\n");
   }

@@ -318,6 +318,7 @@ py::dict diagnose(const std::string& log, const std::string& params, const std::
   py::dict out;
   out["selected"] = r.selection.selected;
   out["partial"] = r.selection.partial;
+  out["ambiguous"] = r.selection.ambiguous;
   out["final_params"] = params_list(r.selection.final_params);
   out["candidates"] = candidates;
   out["mismatch"] = mismatch;

@@ -164,6 +164,7 @@ EvidenceRun run_evidence_case(const EvidenceCase& c, const std::string& dir, dou
     }
     for (const auto& s : r.selection.suspected) run.suspected.push_back(s.id);
     run.partial = r.selection.partial;
+    run.ambiguous = r.selection.ambiguous;
     run.unexplained = static_cast<int>(r.unexplained.size());
 
     score_evidence_run(g.place_passes, &run);
@@ -196,6 +197,7 @@ std::string evidence_run_json(const EvidenceRun& r) {
   j["named_inclusion"] = r.named_inclusion;
   j["suspected"] = r.suspected;
   j["partial"] = r.partial;
+  j["ambiguous"] = r.ambiguous;
   j["unexplained"] = r.unexplained;
   j["acceptable_ids"] = r.acceptable;
   j["out_of_library"] = r.out_of_library;
@@ -235,6 +237,7 @@ std::vector<EvidenceRun> read_evidence_runs(const std::string& jsonl_path) {
       if (j.contains("named_inclusion")) r.named_inclusion = j.at("named_inclusion").get<std::vector<double>>();
       r.suspected = j.at("suspected").get<std::vector<std::string>>();
       if (j.contains("partial")) r.partial = j.at("partial").get<std::vector<std::string>>();
+      if (j.contains("ambiguous")) r.ambiguous = j.at("ambiguous").get<std::string>();
       if (j.contains("unexplained")) r.unexplained = j.at("unexplained").get<int>();
       r.acceptable = j.at("acceptable_ids").get<std::vector<std::string>>();
       r.out_of_library = j.at("out_of_library");
@@ -259,7 +262,8 @@ namespace {
 struct Totals {
   int with_effect = 0, right = 0, right_strict = 0, crossed_once = 0, wrong = 0, worse = 0, clean_runs = 0,
       clean_named = 0, errors = 0;
-  int unexplained = 0, partial = 0;  // runs with an effect that report an unexplained mismatch / a partial correction
+  // Runs with an effect that report an unexplained mismatch / a partial correction / an ambiguous pair.
+  int unexplained = 0, partial = 0, ambiguous = 0;
   std::vector<double> reductions;
 };
 
@@ -283,6 +287,7 @@ Totals totals_of(const std::vector<EvidenceRun>& runs) {
     t.wrong += r.wrong;
     t.unexplained += r.unexplained > 0;
     t.partial += !r.partial.empty();
+    t.ambiguous += !r.ambiguous.empty();
     if (!r.out_of_library) t.reductions.push_back(r.reduction());
   }
   return t;
@@ -337,8 +342,10 @@ std::string evidence_summary_markdown(const std::vector<EvidenceRun>& runs) {
      << (t.with_effect + t.clean_runs) << " |\n"
      << "| median held-out 1-s RMSE reduction (noise-free states, in-library effects) | >= 50 % | " << b << " |\n"
      << "| an unexplained mismatch reported (with an effect) | - | " << pct(t.unexplained, t.with_effect) << " |\n"
-     << "| a partial correction instead of names (with an effect; not counted as named) | - | "
-     << pct(t.partial, t.with_effect) << " |\n";
+     << "| a partial correction (with an effect; its effects are not counted as named) | - | "
+     << pct(t.partial, t.with_effect) << " |\n"
+     << "| a named effect and a substitute reported as ambiguous (with an effect) | - | "
+     << pct(t.ambiguous, t.with_effect) << " |\n";
   if (t.errors) md << "\n" << t.errors << " run(s) failed (see the JSON lines' `error`).\n";
   return md.str();
 }
@@ -359,6 +366,7 @@ std::string evidence_summary_json(const std::vector<EvidenceRun>& runs) {
   j["median_heldout_1s_rmse_reduction_clean"] = median(t.reductions);
   j["unexplained_reported"] = t.unexplained;
   j["partial_correction"] = t.partial;
+  j["ambiguous_reported"] = t.ambiguous;
   j["errors"] = t.errors;
   nlohmann::ordered_json all = nlohmann::ordered_json::array();
   for (const auto& r : runs) all.push_back(nlohmann::ordered_json::parse(evidence_run_json(r)));

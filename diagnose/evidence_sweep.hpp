@@ -25,7 +25,8 @@ struct EvidenceRun {
   int crashes = 0;
   std::vector<std::string> named, suspected, acceptable;  // acceptable: ids of the truth effects
   std::vector<double> named_inclusion;  // per named effect: share of the stability resamples that chose it (-1: none)
-  std::vector<std::string> partial;     // a partial correction beside an unexplained mismatch (not named)
+  std::vector<std::string> partial;     // a partial correction (not named): a mismatch remains, or ambiguous
+  std::string ambiguous;                // named effects and their substitutes (Selection::ambiguous)
   int unexplained = 0;                  // unexplained mismatches reported
   bool out_of_library = false;   // every hidden effect is outside the library
   // Place-dependent effects none of whose discs the car passed twice: no later pass can confirm

@@ -91,6 +91,12 @@ struct SelectionOptions {
   // segments; an effect is named only when chosen in at least this share of them.
   int stability_resamples = 6;
   double min_inclusion_frequency = 0.65;
+  // Substitutes: where a named effect and an effect outside the selection (and outside its
+  // actuator's dynamics) never appear in one resample and some resample took the other in its
+  // place, the data hold two physical explanations (a term that mimics a missing one, e.g. a
+  // throttle gain where the car carries a payload). That effect is then part of a partial
+  // correction (Selection::partial, Selection::ambiguous), not a name.
+  bool withhold_substituted = true;
   std::uint64_t seed = 1;
   double range_limit_margin = 0.01;  // fraction of a search range that counts as "at its end"
   // A time-indexed change is named only when no state-dependent candidate explains at least
@@ -133,6 +139,10 @@ struct Selection {
   // Chosen but not named: they explain a mismatch only in part, and a part no candidate explains
   // remains (unexplained.hpp). They are in final_effects and the model file.
   std::vector<std::string> partial;
+  // Named effects and their substitutes in the stability resamples ("a or b; c or d"; empty:
+  // none): the part of `partial` that the data cannot tell from another physics
+  // (diagnose/substitutes.hpp).
+  std::string ambiguous;
   std::vector<CandidateReport> candidates;      // every candidate considered
   std::vector<SuspectedEffect> suspected;       // "suspected, not identifiable from this recording"
   std::vector<ParamEstimate> final_params;      // joint refit of the selected effects

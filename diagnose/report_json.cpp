@@ -145,6 +145,7 @@ nlohmann::ordered_json report_json(const DiagData& d, const std::string& nominal
   j["screening"] = screening_json(d);
   j["selected"] = res.selection.selected;
   j["partial"] = res.selection.partial;
+  j["ambiguous"] = res.selection.ambiguous;
   j["reliable"] = res.selection.reliable;
   j["verdict"] = res.selection.verdict;
   j["sensor_faults"] = sensor_faults_json(res.selection);

@@ -20,7 +20,9 @@ void write_summary(std::ostream& md, const DiagData& d, const std::string& nomin
      << "- unexplained mismatch (clear in the corrected model's residual, no named effect explains it): "
      << unexplained_summary(res.unexplained) << "\n";
   if (!res.selection.partial.empty()) {
-    md << "- partial correction (in the model file; not named, since the mismatch above remains):";
+    md << "- partial correction (in the model file; not named: a mismatch remains that none explains, or the data "
+          "hold another physics that explains it as well"
+       << (res.selection.ambiguous.empty() ? "" : ": " + res.selection.ambiguous) << "):";
     for (const auto& id : res.selection.partial) md << " " << id;
     md << "\n";
   }

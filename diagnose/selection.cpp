@@ -13,6 +13,7 @@
 #include "diagnose/identifiability.hpp"
 #include "diagnose/joint_refit.hpp"
 #include "diagnose/selection_stages.hpp"
+#include "diagnose/substitutes.hpp"
 
 namespace mppi::diagnose {
 using namespace selection;
@@ -49,8 +50,12 @@ class SelectionRun {
     count_stability();
     pick_dynamics_forms();
     std::vector<std::string> named = name_effects();
+    find_substitutes_of(named);
     refit_named(named);
-    if (!heldout_veto(named)) state_verdict();
+    if (!heldout_veto(named)) {
+      state_verdict();
+      if (opt_.withhold_substituted) mark_partial_where_substituted(substitutes_, &sel_);
+    }
     return std::move(sel_);
   }
 
@@ -126,6 +131,7 @@ class SelectionRun {
     if (!main_.chosen.empty() && opt_.stability_resamples > 0) {
       const std::vector<std::vector<int>> chosen = stability_resamples(folds(), candidate_set(), stable_pool, main_, opt_,
                                                                        problems_.n_eff, problems_.len, d_.dt_s);
+      resample_choices_ = chosen;
       for (std::size_t b = 0; b < chosen.size(); ++b) {
         const std::vector<int>& c = chosen[b];
         const std::vector<std::string> ids = ids_of(cands_, c);
@@ -252,6 +258,24 @@ class SelectionRun {
     return named;
   }
 
+  // The stability stage's substitutes (diagnose/substitutes.hpp) among the named effects.
+  void find_substitutes_of(const std::vector<std::string>& named) {
+    std::vector<std::string> chosen_on_all;
+    for (int c : main_.chosen)
+      for (int m : members_[static_cast<std::size_t>(c)]) chosen_on_all.push_back(cands_[static_cast<std::size_t>(m)]->id);
+    std::vector<std::vector<std::string>> resamples;
+    for (const auto& chosen : resample_choices_) {
+      resamples.emplace_back();
+      for (int c : chosen)
+        for (int m : members_[static_cast<std::size_t>(c)]) resamples.back().push_back(cands_[static_cast<std::size_t>(m)]->id);
+    }
+    substitutes_ = find_substitutes(named, chosen_on_all, resamples, [&](const std::string& id) {
+      for (const EffectSpec* c : cands_)
+        if (c->id == id) return c->dynamics_of;
+      return std::string();
+    });
+  }
+
   void refit_named(std::vector<std::string>& named) {
     const FitProblem& all = problems_.all;
     // Joint refit of the named effects on all training segments (parameters at a bound held at
@@ -348,6 +372,8 @@ class SelectionRun {
   double held_nominal_ = 0;
   GreedyResult main_;
   std::vector<int> inclusion_;                     // resamples that chose each candidate
+  std::vector<std::vector<int>> resample_choices_;  // what each resample chose (candidate indices)
+  std::vector<SubstitutePair> substitutes_;         // named effects with a rival in the resamples
   std::map<std::string, int> dynamics_inclusion_;  // resamples that chose some form of an actuator's dynamics
   std::vector<int> family_pick_;                   // candidates named for their actuator's dynamics
   EffectParams family_effects_;                   // the family picks' own first-round fits as start values

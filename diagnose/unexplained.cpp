@@ -61,7 +61,7 @@ std::vector<Mismatch> unexplained_of_both(const std::vector<Mismatch>& nominal_s
 
 void mark_partial_where_unexplained(const std::vector<Mismatch>& long_look, Selection* selection) {
   if (long_look.empty() || selection->selected.empty()) return;
-  selection->partial = selection->selected;
+  selection->partial.insert(selection->partial.end(), selection->selected.begin(), selection->selected.end());
   selection->selected.clear();
   std::string ids;
   for (const std::string& id : selection->partial) ids += (ids.empty() ? "" : ", ") + id;

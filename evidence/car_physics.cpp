@@ -123,7 +123,11 @@ CarState car_derivative(const CarConstants& c, const CarState& s, const CarInput
   const double wheelbase_term = lf_m + lr_m + c.cg_height_m * (fmx * cd - fmy * sd - rmx);
   double fz_front = weight * (lr_m - c.cg_height_m * rmx) / std::max(wheelbase_term, 1e-3);
   fz_front = std::clamp(fz_front, 0.0, weight);
-  const double fz_rear = weight - fz_front;
+  double fz_rear = weight - fz_front;
+  // Downforce acts at the CG's position along the car: the static split.
+  const double downforce_N = in.downforce_kgpm * vx * vx;
+  fz_front += downforce_N * lr_m / (lf_m + lr_m);
+  fz_rear += downforce_N * lf_m / (lf_m + lr_m);
   const double ffx = fmx * fz_front, ffy = fmy * fz_front, frx = rmx * fz_rear, fry = rmy * fz_rear;
   if (forces) *forces = {{ffx, ffy, fz_front}, {frx, fry, fz_rear}};
 

@@ -44,6 +44,7 @@ struct CarInputs {
   double gravity_x_mps2 = 0;     // tangential gravity along body x, y (the grade)
   double gravity_y_mps2 = 0;
   double extra_drag_kgpm = 0;    // aerodynamic drag -c |v| v along the velocity vector
+  double downforce_kgpm = 0;     // aerodynamic downforce c v_x^2 on both axles, split as the static load
   double front_rolling_coefficient = 0, rear_rolling_coefficient = 0;  // per axle, x its load
   double mass_scale = 1, yaw_inertia_scale = 1;  // payload
   double cg_rearward_m = 0;      // the CG sits this much nearer the rear axle (l_f + d, l_r - d)

@@ -89,6 +89,7 @@ CarInputs car_inputs_at(const CarState& s, double wheel_angle_rad, double motor_
   const sim::Vec2 slope = ground.map.slope(s[kX], s[kY]);
   ground_gravity_body(slope.x, slope.y, s[kYaw], car.gravity_mps2, &in.gravity_x_mps2, &in.gravity_y_mps2);
   in.extra_drag_kgpm = truth.extra_drag_kgpm;
+  in.downforce_kgpm = truth.downforce_kgpm;
   in.front_rolling_coefficient = truth.front_rolling_coefficient;
   in.rear_rolling_coefficient = truth.rear_rolling_coefficient;
   in.mass_scale = truth.payload_mass_scale;

@@ -26,6 +26,9 @@ struct TruthEffects {
   double battery_capacity_sag = 0;
   // Chassis and environment.
   double extra_drag_kgpm = 0;     // -c |v| v along the velocity vector
+  // Aerodynamic downforce c v_x^2 [N] pressing both axles (split as the static load): the tyres'
+  // force capacity grows with speed. The diagnosis' library has no such term.
+  double downforce_kgpm = 0;
   double front_rolling_coefficient = 0, rear_rolling_coefficient = 0;  // per axle, x its load
   double payload_mass_scale = 1, payload_yaw_inertia_scale = 1;
   double weight_shift = 0;        // the CG sits this share of the wheelbase further back (a battery moved)

@@ -191,6 +191,33 @@ TEST_CASE("evidence: a weight shift moves the static axle loads to m g (l_r - d)
   CHECK(std::abs(car_derivative(c, s, unshifted)[kR] - ds[kR]) > 0.1);
 }
 
+TEST_CASE("evidence: downforce c v^2 adds to the axle loads in the static split, and the side force with them", "[evidence]") {
+  const CarConstants c = frictionless_straight();
+  const double wheelbase_m = c.lf_m + c.lr_m, weight_N = c.mass_kg * c.gravity_mps2;
+  for (const double v : {2.0, 6.0}) {
+    INFO("v " << v << " m/s");
+    CarInputs in;
+    in.downforce_kgpm = 0.8;
+    CarForces f;
+    car_derivative(c, rolling(v, c), in, &f);
+    const double down_N = 0.8 * v * v;
+    CHECK(f.front.fz_N == Approx((weight_N + down_N) * c.lr_m / wheelbase_m).epsilon(1e-9));
+    CHECK(f.rear.fz_N == Approx((weight_N + down_N) * c.lf_m / wheelbase_m).epsilon(1e-9));
+  }
+  // Sliding sideways at 6 m/s: the tyres' side force is mu x load, so it grows by the downforce's share.
+  CarConstants grippy = c;
+  grippy.mf_D = 1.0;
+  CarState s = rolling(6.0, grippy);
+  s[kVy] = 0.5;
+  CarInputs none, down;
+  down.downforce_kgpm = 0.8;
+  CarForces f0, f1;
+  car_derivative(grippy, s, none, &f0);
+  car_derivative(grippy, s, down, &f1);
+  CHECK(f1.rear.fy_N / f0.rear.fy_N == Approx(f1.rear.fz_N / f0.rear.fz_N).epsilon(1e-9));
+  CHECK(f1.rear.fz_N > f0.rear.fz_N * 1.1);
+}
+
 // Closed form: a launch on Coulomb tyres (C = 1, B huge: mu = D at any real slip), no load
 // transfer, a motor far stronger than the grip. Rear-wheel drive spins the rear wheels only: the
 // rear axle's load m g l_f / L pushes the car and the rolling front wheels,
