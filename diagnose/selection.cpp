@@ -260,16 +260,15 @@ class SelectionRun {
 
   // The stability stage's substitutes (diagnose/substitutes.hpp) among the named effects.
   void find_substitutes_of(const std::vector<std::string>& named) {
-    std::vector<std::string> chosen_on_all;
-    for (int c : main_.chosen)
-      for (int m : members_[static_cast<std::size_t>(c)]) chosen_on_all.push_back(cands_[static_cast<std::size_t>(m)]->id);
-    std::vector<std::vector<std::string>> resamples;
-    for (const auto& chosen : resample_choices_) {
-      resamples.emplace_back();
+    auto library_ids = [&](const std::vector<int>& chosen) {  // joint candidates as their members
+      std::vector<std::string> ids;
       for (int c : chosen)
-        for (int m : members_[static_cast<std::size_t>(c)]) resamples.back().push_back(cands_[static_cast<std::size_t>(m)]->id);
-    }
-    substitutes_ = find_substitutes(named, chosen_on_all, resamples, [&](const std::string& id) {
+        for (int m : members_[static_cast<std::size_t>(c)]) ids.push_back(cands_[static_cast<std::size_t>(m)]->id);
+      return ids;
+    };
+    std::vector<std::vector<std::string>> resamples;
+    for (const auto& chosen : resample_choices_) resamples.push_back(library_ids(chosen));
+    substitutes_ = find_substitutes(named, library_ids(main_.chosen), resamples, [&](const std::string& id) {
       for (const EffectSpec* c : cands_)
         if (c->id == id) return c->dynamics_of;
       return std::string();

@@ -1,6 +1,7 @@
 #include "evidence/truth_effects.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <utility>
 
@@ -69,8 +70,8 @@ const std::vector<TruthEffectInfo>& truth_effect_catalogue() {
       {"aero_drag_vector", {"extra_drag_kgpm"}, {"aero_drag"}, "drag -c |v| v along the velocity vector",
        "extra_drag_kgpm=0.15", "extra_drag_kgpm=0.5"},
       // Out of library (no table id): the right answer names nothing, or reports the mismatch as
-      // unexplained. Not in the grid (its bars are for effects the library can name): run with
-      // --effects aero_downforce.
+      // unexplained. Not in the grid, whose measures are of effects the library can name: run
+      // with --effects aero_downforce.
       {"aero_downforce", {"downforce_kgpm"}, {},
        "aerodynamic downforce c v_x^2 on both axles, split as the static load: grip grows with speed",
        "downforce_kgpm=0.4", "downforce_kgpm=1.2", false},
@@ -136,6 +137,9 @@ std::vector<std::string> set_truth_effects(const std::string& assignments, Truth
     } catch (const std::logic_error&) {
       throw Error("evidence effect '" + item + "': value is not a number");
     }
+    if (!std::isfinite(v)) throw Error("evidence effect '" + item + "': value is not finite");
+    if (key == "downforce_kgpm" && v < 0)
+      throw Error("evidence effect '" + item + "': downforce must be >= 0 (lift would unload the tyres)");
     bool found = false;
     for (const auto& [name, member] : fields())
       if (name == key) {

@@ -218,6 +218,16 @@ TEST_CASE("evidence: downforce c v^2 adds to the axle loads in the static split,
   CHECK(f1.rear.fz_N > f0.rear.fz_N * 1.1);
 }
 
+TEST_CASE("evidence: effect sizes must be finite, and downforce not negative", "[evidence]") {
+  TruthEffects e;
+  CHECK_THROWS_WITH(set_truth_effects("downforce_kgpm=-0.5", &e), Catch::Contains("downforce must be >= 0"));
+  CHECK_THROWS_WITH(set_truth_effects("extra_drag_kgpm=nan", &e), Catch::Contains("'extra_drag_kgpm=nan': value is not finite"));
+  CHECK(e.downforce_kgpm == 0);
+  CHECK(e.extra_drag_kgpm == 0);
+  CHECK(set_truth_effects("downforce_kgpm=0.4", &e) == std::vector<std::string>{"aero_downforce"});
+  CHECK(e.downforce_kgpm == 0.4);
+}
+
 // Closed form: a launch on Coulomb tyres (C = 1, B huge: mu = D at any real slip), no load
 // transfer, a motor far stronger than the grip. Rear-wheel drive spins the rear wheels only: the
 // rear axle's load m g l_f / L pushes the car and the rolling front wheels,
