@@ -253,8 +253,10 @@ int mppi_fit_calibrate(int argc, char** argv) {
     const std::vector<double> x0(AutoRallyNetwork::kNx, 0.0);
     std::vector<sim::Recording> train_pieces = {roll_out_manoeuvres(net_step, x0, train_opt)};
     for (const std::string& f : train_logs) train_pieces.push_back(read_learned_model_log(f));
-    const sim::Recording train = join_recordings(train_pieces);
-    const sim::Recording held = roll_out_manoeuvres(net_step, x0, held_opt);
+    const sim::Recording train_table = join_recordings(train_pieces);
+    const sim::Recording held_table = roll_out_manoeuvres(net_step, x0, held_opt);
+    const PreparedRecording train = prepare(train_table, "the training recording", 3);
+    const PreparedRecording held = prepare(held_table, "the held-out manoeuvres", 3);
     std::vector<sim::Recording> held_log_pieces;
     for (const std::string& f : heldout_logs) held_log_pieces.push_back(read_learned_model_log(f));
 
@@ -279,8 +281,8 @@ int mppi_fit_calibrate(int argc, char** argv) {
     const PredictionError train_after = prediction_error(spec, fit.values, train, train_scales, cal.error);
 
     std::filesystem::create_directories(out_dir);
-    write_recording(train, out_dir + "/train.csv");
-    write_recording(held, out_dir + "/heldout.csv");
+    write_recording(train_table, out_dir + "/train.csv");
+    write_recording(held_table, out_dir + "/heldout.csv");
     {
       // Fitted actuator terms (steer_lag_s, ...) are effects of the corrected model: then the
       // file is a corrected-model file (the plant as nominal_params, the actuators as effects)
@@ -326,7 +328,7 @@ int mppi_fit_calibrate(int argc, char** argv) {
     summary += line;
     std::string table = error_table(before, after);
     if (!held_log_pieces.empty()) {
-      const sim::Recording held_logs = join_recordings(held_log_pieces);
+      const PreparedRecording held_logs = prepare(join_recordings(held_log_pieces), "the held-out logs", 3);
       const std::vector<double> log_scales = channel_scales(held_logs, cal.error.channels);
       const PredictionError log_before = prediction_error(spec, spec.nominal, held_logs, log_scales, cal.error);
       const PredictionError log_after = prediction_error(spec, fit.values, held_logs, log_scales, cal.error);

@@ -105,10 +105,10 @@ int cmd_diagnose(DiagnoseArgs& args) {
   o.params_source = params;
   // Several recordings are fitted jointly (concatenated as separate pieces); every --validate
   // recording is held out and scored on its own.
-  DiagData d = load_any(args.logs[0]);
+  PreparedRecording d = load_any(args.logs[0]);
   for (std::size_t i = 1; i < args.logs.size(); ++i) d = concat(d, load_any(args.logs[i]));
   // The test data: the end of --log cut off before anything else sees it, and/or --test files.
-  std::optional<DiagData> test;
+  std::optional<PreparedRecording> test;
   std::string test_name;
   if (args.test_fraction > 0) {
     const auto cut = static_cast<std::size_t>(std::lround(static_cast<double>(d.rows()) * (1.0 - args.test_fraction)));
@@ -119,7 +119,7 @@ int cmd_diagnose(DiagnoseArgs& args) {
     test_name = name;
   }
   for (const auto& f : args.tests) {
-    const DiagData t = load_any(f);
+    const PreparedRecording t = load_any(f);
     test = test ? concat(*test, t) : t;
     test_name += (test_name.empty() ? "" : " + ") + f;
   }

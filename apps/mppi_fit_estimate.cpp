@@ -98,7 +98,7 @@ int run_estimate(EstimateArgs& args) {
       spec = E::spec(base, estimate_names, keep_wheelbase);
       if (have_truth) truth_spec = E::spec(E::load_params(truth_file), estimate_names);
     });
-    const sim::Recording rec = load_any_recording(resolve(input));
+    const PreparedRecording rec = prepare(load_any_recording(resolve(input)), input, 3);
     const std::size_t np = spec.estimated.size();
     std::vector<double> truth(np, NAN);
     if (have_truth) truth = truth_spec.nominal;
@@ -142,7 +142,7 @@ int run_estimate(EstimateArgs& args) {
         spec.init_state(rec, r, xa.data());
         for (std::size_t j = 0; j < np; ++j) xa(nx + j) = spec.nominal[j];
         Vec u(3);
-        u << rec.column("steer")[r], rec.column("throttle")[r], t[r + 1] - t[r];
+        u << rec.steer_over(r), rec.throttle_over(r), t[r + 1] - t[r];
         xs.push_back(xa);
         us.push_back(u);
       }
@@ -233,11 +233,11 @@ int run_estimate(EstimateArgs& args) {
                      conv, 3, 380, 220);
 
     // Validation: held-out window or recording, estimated vs nominal parameters.
-    sim::Recording val_rec;
+    PreparedRecording val_rec;
     std::size_t vb = 0, ve = 0;
     bool validate = false;
     if (!val_file.empty()) {
-      val_rec = load_any_recording(resolve(val_file));
+      val_rec = prepare(load_any_recording(resolve(val_file)), val_file, 3);
       vb = 0;
       ve = val_rec.rows();
       validate = true;

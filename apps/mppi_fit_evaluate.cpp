@@ -12,7 +12,7 @@
 #include "base/error.hpp"
 #include "cli/app.hpp"
 #include "cli/options.hpp"
-#include "diagnose/data.hpp"
+#include "sysid/prepared_recording.hpp"
 #include "diagnose/evaluate.hpp"
 #include "diagnose/model_comparison.hpp"
 #include "dynamics/corrected_model.hpp"
@@ -38,7 +38,7 @@ int run_evaluate(EvaluateArgs& args) {
         throw Error(args.model_file + ": --rows heldout needs the file's fitted_on.heldout (written by mppi-fit diagnose)");
       o.rows = it->second;
     }
-    const DiagData d = load_any(args.log);
+    const PreparedRecording d = load_any(args.log);
     const EvaluateResult r = evaluate_corrected_model(model, args.model_file, d, o);
     std::printf("%s on %s (%zu rows scored, rows %s)\n", args.model_file.c_str(), d.source.c_str(), r.rows_scored,
                 o.rows.c_str());

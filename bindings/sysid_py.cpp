@@ -107,7 +107,7 @@ py::dict estimate(const std::string& recording, const std::string& model, const 
   }
   std::string why;
   if (!st.is_valid(&why)) throw mppi::Error("estimate_parameters: " + why);
-  const mppi::sim::Recording rec = load(recording);
+  const mppi::sysid::PreparedRecording rec = mppi::sysid::prepare(load(recording), recording, 3);
   const std::vector<double> truth =
       truth_file.empty() ? std::vector<double>() : values_in(model, truth_file, spec.estimated);
   EstimateResult res;
@@ -175,7 +175,7 @@ py::dict validate(const std::string& recording, const std::string& model, const 
   for (const auto& [n, x] : values) names.push_back(n), v.push_back(x);
   const VehicleModelSpec spec = make_spec(model, params_file, names.empty() ? std::vector<std::string>{"mass_kg"} : names, false);
   if (names.empty()) v = spec.nominal;
-  const mppi::sim::Recording rec = load(recording);
+  const mppi::sysid::PreparedRecording rec = mppi::sysid::prepare(load(recording), recording, 3);
   std::size_t b = 0, e = rec.rows();
   if (!window.is_none()) {
     const auto w = window.cast<std::pair<double, double>>();
@@ -297,7 +297,7 @@ py::dict diagnose(const std::string& log, const std::string& params, const std::
   DiagnoseResult r;
   {
     py::gil_scoped_release release;
-    DiagData d = load_any(resolve(log));
+    PreparedRecording d = load_any(resolve(log));
     if (!validate_log.empty()) {  // fit on log, judge on validate_log (as mppi-fit diagnose --validate)
       const std::size_t first = d.rows();
       d = concat(d, load_any(resolve(validate_log)));

@@ -9,7 +9,7 @@
 
 namespace mppi::diagnose {
 
-std::vector<char> control_loss_rows(const DiagData& d, const ControlLossOptions& o) {
+std::vector<char> control_loss_rows(const PreparedRecording& d, const ControlLossOptions& o) {
   if (!(o.max_body_slip_deg >= 0 && o.max_body_slip_deg <= 90) || !(o.min_speed_mps >= 0) || !std::isfinite(o.min_speed_mps) ||
       !(o.guard_s >= 0) || !std::isfinite(o.guard_s)) {
     char why[200];

@@ -20,6 +20,6 @@ struct ControlLossOptions {
 // 1 for each row within guard_s of a row whose body slip (folded, so that reversing is not a
 // slip of 180 deg) exceeds max_body_slip_deg at more than min_speed_mps. Throws mppi::Error for
 // options out of range (a slip limit outside [0, 90] deg, a negative or non-finite speed or guard).
-std::vector<char> control_loss_rows(const DiagData& d, const ControlLossOptions& o = {});
+std::vector<char> control_loss_rows(const PreparedRecording& d, const ControlLossOptions& o = {});
 
 }  // namespace mppi::diagnose

@@ -30,7 +30,7 @@ namespace {
 // Leaves the rows of lost control out of *select_rows (the training rows) where enough is left,
 // and counts those among the training rows in *lost_training_rows. Returns the selection log's line
 // about them (empty where there are none).
-std::string leave_out_control_loss(const DiagData& d, const std::vector<char>& train, const DiagnoseOptions& o,
+std::string leave_out_control_loss(const PreparedRecording& d, const std::vector<char>& train, const DiagnoseOptions& o,
                                    std::vector<char>* select_rows, std::size_t* lost_training_rows) {
   const std::vector<char> lost = control_loss_rows(d, o.control_loss);
   std::size_t n_train = 0;
@@ -59,7 +59,7 @@ std::string leave_out_control_loss(const DiagData& d, const std::vector<char>& t
 
 // The held-out scores: one-step, then the multi-step horizons; the headline and the explained
 // share; per held-out recording.
-void score_heldout(const DiagData& d, const ReplayModel& nominal_model, const ReplayModel& corrected,
+void score_heldout(const PreparedRecording& d, const ReplayModel& nominal_model, const ReplayModel& corrected,
                    const std::vector<char>& held, const DiagnoseOptions& o, DiagnoseResult* res) {
   std::vector<double> hs = {d.dt_s};
   hs.insert(hs.end(), o.horizons_s.begin(), o.horizons_s.end());
@@ -85,7 +85,7 @@ void score_heldout(const DiagData& d, const ReplayModel& nominal_model, const Re
 
 // OUT/corrected_model.yaml where the correction is reliable (its path in res->model_file); where
 // it is not, any earlier one is removed.
-void write_corrected_model(const DiagData& d, const ModelFamily& nominal, const DiagnoseOptions& o,
+void write_corrected_model(const PreparedRecording& d, const ModelFamily& nominal, const DiagnoseOptions& o,
                            DiagnoseResult* res) {
   std::vector<std::string> in_model = res->selection.selected;  // named, or a partial correction
   in_model.insert(in_model.end(), res->selection.partial.begin(), res->selection.partial.end());
@@ -118,7 +118,7 @@ struct FigureInputs {
 };
 
 // report.json (also in res->json), and in OUT report.md, the PNGs and report.html.
-void write_reports(const DiagData& d, const std::string& nominal_name, const DiagnoseOptions& o,
+void write_reports(const PreparedRecording& d, const std::string& nominal_name, const DiagnoseOptions& o,
                    const FigureInputs& f, DiagnoseResult* res) {
   json j = report_json(d, nominal_name, o, *res);
   // The report's figures: the same data in report.json, the PNGs and report.html.
@@ -147,7 +147,7 @@ void write_reports(const DiagData& d, const std::string& nominal_name, const Dia
 
 }  // namespace
 
-DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, const DiagnoseOptions& o) {
+DiagnoseResult run_diagnosis(const PreparedRecording& d, const ModelFamily& nominal, const DiagnoseOptions& o) {
   DiagnoseResult res;
   const Split split = make_split(d, o.holdout);
   std::vector<char> train(d.rows()), held = split.heldout;

@@ -40,7 +40,7 @@ struct DiagnoseOptions {
   // Data that neither the fit nor the validation (the held-out part, which also decides whether
   // a correction is written) sees: the correction the selection arrived at is scored on it
   // afterwards, written or not. nullptr = none. test_name names it in the report.
-  const DiagData* test = nullptr;
+  const PreparedRecording* test = nullptr;
   std::string test_name;
 };
 
@@ -74,6 +74,6 @@ struct DiagnoseResult {
 };
 
 // `nominal`: make_model_family(model, params file) (diagnose/model_family.hpp).
-DiagnoseResult run_diagnosis(const DiagData& d, const ModelFamily& nominal, const DiagnoseOptions& o);
+DiagnoseResult run_diagnosis(const PreparedRecording& d, const ModelFamily& nominal, const DiagnoseOptions& o);
 
 }  // namespace mppi::diagnose

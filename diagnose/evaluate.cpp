@@ -24,7 +24,7 @@ std::string number_text(double v) {
 }
 
 // The recording's metadata value as a number; false where absent or not a positive number.
-bool metadata_number(const DiagData& d, const std::string& key, double* value) {
+bool metadata_number(const PreparedRecording& d, const std::string& key, double* value) {
   const auto it = d.metadata.find(key);
   if (it == d.metadata.end()) return false;
   try {
@@ -62,7 +62,7 @@ std::optional<double> kinematic_wheelbase(const CorrectedModelFile& m) {
 }
 
 void check_close(const std::string& what, double model_value, double recording_value, double tolerance,
-                 const std::string& model_source, const DiagData& d) {
+                 const std::string& model_source, const PreparedRecording& d) {
   if (std::abs(model_value - recording_value) <= tolerance * recording_value) return;
   throw Error(model_source + " and " + d.source + " are not of the same car: " + what + " " +
               number_text(model_value) + " in the model, " + number_text(recording_value) +
@@ -71,7 +71,7 @@ void check_close(const std::string& what, double model_value, double recording_v
 
 }  // namespace
 
-std::map<std::string, std::string> fitted_on_of(const DiagData& d) {
+std::map<std::string, std::string> fitted_on_of(const PreparedRecording& d) {
   std::map<std::string, std::string> f;
   f["source"] = d.source;
   const auto vehicle = d.metadata.find("vehicle");
@@ -82,7 +82,7 @@ std::map<std::string, std::string> fitted_on_of(const DiagData& d) {
 }
 
 void check_model_matches_recording(const CorrectedModelFile& model, const std::string& model_source,
-                                   const DiagData& d, const EvaluateOptions& o) {
+                                   const PreparedRecording& d, const EvaluateOptions& o) {
   const auto fitted_vehicle = model.fitted_on.find("vehicle");
   const auto recorded_vehicle = d.metadata.find("vehicle");
   if (fitted_vehicle != model.fitted_on.end() && recorded_vehicle != d.metadata.end() &&
@@ -110,7 +110,7 @@ void check_model_matches_recording(const CorrectedModelFile& model, const std::s
 }
 
 EvaluateResult evaluate_corrected_model(const CorrectedModelFile& model, const std::string& model_source,
-                                        const DiagData& d, const EvaluateOptions& o) {
+                                        const PreparedRecording& d, const EvaluateOptions& o) {
   check_model_matches_recording(model, model_source, d, o);
   std::vector<char> mask(d.rows(), 1);
   if (o.rows != "all") mask = make_split(d, o.rows).heldout;

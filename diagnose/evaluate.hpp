@@ -35,14 +35,14 @@ struct EvaluateResult : ModelComparison {
 // `# vehicle:`, the command the throttle column holds (throttle or speed), and the model's mass
 // and wheelbase against the recording's metadata, where both sides give them.
 void check_model_matches_recording(const CorrectedModelFile& model, const std::string& model_source,
-                                   const DiagData& d, const EvaluateOptions& o = {});
+                                   const PreparedRecording& d, const EvaluateOptions& o = {});
 
 // The corrected model and its nominal model replayed on d's scored rows. Checks the match first.
 EvaluateResult evaluate_corrected_model(const CorrectedModelFile& model, const std::string& model_source,
-                                        const DiagData& d, const EvaluateOptions& o = {});
+                                        const PreparedRecording& d, const EvaluateOptions& o = {});
 
 // What the corrected-model file records of the recording a diagnosis fitted it on (its
 // fitted_on section): the recording's source, vehicle and command kind, its sample interval.
-std::map<std::string, std::string> fitted_on_of(const DiagData& d);
+std::map<std::string, std::string> fitted_on_of(const PreparedRecording& d);
 
 }  // namespace mppi::diagnose

@@ -148,8 +148,8 @@ EvidenceRun run_evidence_case(const EvidenceCase& c, const std::string& dir, dou
     run.driver = g.driver;
     run.crashes = g.crashes;
 
-    const DiagData d = load_recording(csv);
-    const DiagData clean = load_recording(g.clean_csv);
+    const PreparedRecording d = load_recording(csv);
+    const PreparedRecording clean = load_recording(g.clean_csv);
     // The nominal is the vehicle file the generator's car was built from: an effect-free
     // recording then has the nominal physics (computed by other code), as on a real car whose
     // parameter file is known.

@@ -18,7 +18,7 @@ namespace mppi::diagnose {
 
 // The data a fit works on: segments and channel scales.
 struct FitProblem {
-  const DiagData* data = nullptr;
+  const PreparedRecording* data = nullptr;
   const ModelFamily* family = nullptr;  // the nominal model; members = nominal + effects
   std::vector<Segment> segments;
   std::array<double, kChannels> scale{};
@@ -155,7 +155,7 @@ struct Selection {
 
 // Runs the selection on the training rows (train_mask) and judges the corrected model on the
 // held-out rows (heldout_mask): when it is not better than the nominal there, nothing is named.
-Selection select_effects(const DiagData& d, const ModelFamily& nominal,
+Selection select_effects(const PreparedRecording& d, const ModelFamily& nominal,
                          const std::vector<char>& train_mask, const std::vector<char>& heldout_mask,
                          const SelectionOptions& options = {}, const ReplayOptions& replay = {});
 

@@ -41,7 +41,7 @@ std::string format(const char* fmt, double a, double b) {
 
 }  // namespace
 
-ExcitationLevels measure_excitation(const DiagData& d, const std::vector<char>& mask) {
+ExcitationLevels measure_excitation(const PreparedRecording& d, const std::vector<char>& mask) {
   std::vector<double> steer, r, throttle, vx, ay, ax;
   const int lag = std::max(1, static_cast<int>(std::lround(0.1 / d.dt_s)));
   for (std::size_t k = 0; k < d.rows(); ++k) {

@@ -23,7 +23,7 @@ struct ExcitationLevels {
 };
 
 // Levels over the rows in `mask` (empty = all usable rows).
-ExcitationLevels measure_excitation(const DiagData& d, const std::vector<char>& mask);
+ExcitationLevels measure_excitation(const PreparedRecording& d, const std::vector<char>& mask);
 
 // Empty when the recording excites what `needs` asks for; otherwise why not, with the numbers.
 std::string excitation_shortfall(Excitation needs, const ExcitationLevels& levels);

@@ -8,7 +8,7 @@
 
 namespace mppi::diagnose {
 
-ResidualSeries residual_series(const ReplayModel& model, const DiagData& d, double horizon_s,
+ResidualSeries residual_series(const ReplayModel& model, const PreparedRecording& d, double horizon_s,
                                const ReplayOptions& o) {
   ResidualSeries rs;
   const int len = std::max(1, static_cast<int>(std::lround(horizon_s / d.dt_s)));
@@ -29,7 +29,7 @@ ResidualSeries residual_series(const ReplayModel& model, const DiagData& d, doub
   return rs;
 }
 
-std::vector<double> regime_variable(const DiagData& d, int regime) {
+std::vector<double> regime_variable(const PreparedRecording& d, int regime) {
   const std::size_t n = d.rows();
   std::vector<double> v(n, 0.0);
   for (std::size_t k = 0; k < n; ++k) {
@@ -107,7 +107,7 @@ struct PlaceCell {
   double x0, x1, y0, y1;
   BinStat stat;
 };
-std::vector<PlaceCell> place_cells(const DiagData& d, const std::vector<double>& resid, const std::vector<char>& mask,
+std::vector<PlaceCell> place_cells(const PreparedRecording& d, const std::vector<double>& resid, const std::vector<char>& mask,
                                    double spi) {
   constexpr int kCells = 4;
   double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
@@ -153,7 +153,7 @@ std::string range_text(const char* name, double lo, double hi, const char* unit)
 
 }  // namespace
 
-std::vector<Mismatch> locate(const DiagData& d, const ResidualSeries& res, const std::vector<char>& mask,
+std::vector<Mismatch> locate(const PreparedRecording& d, const ResidualSeries& res, const std::vector<char>& mask,
                              double min_z, int bins) {
   std::vector<Mismatch> out;
   const double spi = std::max(1.0, res.horizon_s / d.dt_s);  // overlapping predictions are correlated

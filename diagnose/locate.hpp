@@ -16,7 +16,7 @@ struct ResidualSeries {
   double horizon_s = 0.2;
   std::vector<double> e[kChannels];
 };
-ResidualSeries residual_series(const ReplayModel& model, const DiagData& d, double horizon_s,
+ResidualSeries residual_series(const ReplayModel& model, const PreparedRecording& d, double horizon_s,
                                const ReplayOptions& o = {});
 
 // The regime variables, per row.
@@ -24,7 +24,7 @@ inline constexpr int kRegimes = 6;
 inline const char* const kRegimeNames[kRegimes] = {"speed", "lateral_accel", "longitudinal_accel",
                                                     "steer", "throttle", "steer_rate"};
 inline const char* const kRegimeUnits[kRegimes] = {"m/s", "m/s^2", "m/s^2", "1", "1", "1/s"};
-std::vector<double> regime_variable(const DiagData& d, int regime);
+std::vector<double> regime_variable(const PreparedRecording& d, int regime);
 
 struct BinStat {
   double lo = 0, hi = 0;    // regime range of the bin
@@ -46,7 +46,7 @@ struct Mismatch {
 };
 // Findings sorted by |z|, strongest first: per channel the overall bias, the regime bins whose
 // mean residual stands out, and time windows from binary-segmentation change detection.
-std::vector<Mismatch> locate(const DiagData& d, const ResidualSeries& res, const std::vector<char>& mask,
+std::vector<Mismatch> locate(const PreparedRecording& d, const ResidualSeries& res, const std::vector<char>& mask,
                              double min_z = 4.0, int bins = 4);
 
 }  // namespace mppi::diagnose

@@ -4,7 +4,7 @@
 
 namespace mppi::diagnose {
 
-ModelComparison compare_models(const ReplayModel& nominal, const ReplayModel& corrected, const DiagData& d,
+ModelComparison compare_models(const ReplayModel& nominal, const ReplayModel& corrected, const PreparedRecording& d,
                                const std::vector<char>& mask, const std::vector<double>& horizons_s,
                                double headline_horizon_s, const ReplayOptions& o) {
   std::vector<double> hs = {d.dt_s};

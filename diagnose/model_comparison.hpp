@@ -19,7 +19,7 @@ struct ModelComparison {
 };
 
 // Both models replayed from the rows of `mask` (1 = scored) at d.dt_s and `horizons_s`.
-ModelComparison compare_models(const ReplayModel& nominal, const ReplayModel& corrected, const DiagData& d,
+ModelComparison compare_models(const ReplayModel& nominal, const ReplayModel& corrected, const PreparedRecording& d,
                                const std::vector<char>& mask, const std::vector<double>& horizons_s,
                                double headline_horizon_s, const ReplayOptions& o);
 

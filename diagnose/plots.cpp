@@ -32,7 +32,7 @@ void add_pieces(plot::Panel& p, const plot::Series& s) {
 
 // The measured x-y path through the held-out rows, broken where rows are not consecutive; every
 // thin-th row, and the ends of each stretch.
-plot::Series measured_path(const DiagData& d, const std::vector<std::size_t>& rows, std::size_t thin) {
+plot::Series measured_path(const PreparedRecording& d, const std::vector<std::size_t>& rows, std::size_t thin) {
   plot::Series m = line({}, {}, kMeasured, "measured", 1.0);
   std::size_t prev = rows.front();
   for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -51,7 +51,7 @@ plot::Series measured_path(const DiagData& d, const std::vector<std::size_t>& ro
 }
 
 // The 2-s open-loop x-y predictions of both models, one every 1 s of the held-out rows.
-void add_xy_predictions(plot::Panel& pxy, const DiagData& d, const ReplayModel& nominal, const ReplayModel& corrected,
+void add_xy_predictions(plot::Panel& pxy, const PreparedRecording& d, const ReplayModel& nominal, const ReplayModel& corrected,
                         const std::vector<char>& mask, const ReplayOptions& o) {
   const int len2 = std::max(1, static_cast<int>(std::lround(2.0 / d.dt_s)));
   const int every = std::max(1, static_cast<int>(std::lround(1.0 / d.dt_s)));
@@ -74,7 +74,7 @@ void add_xy_predictions(plot::Panel& pxy, const DiagData& d, const ReplayModel& 
 
 // Channel c over time: measured, and both models' predictions 1 s ahead (len1 rows, predicted
 // into pr, len1 * kPredStride values).
-plot::Panel channel_panel(int c, const DiagData& d, const std::vector<std::size_t>& rows, std::size_t thin,
+plot::Panel channel_panel(int c, const PreparedRecording& d, const std::vector<std::size_t>& rows, std::size_t thin,
                           const ReplayModel& nominal, const ReplayModel& corrected, const ReplayOptions& o, int len1,
                           std::vector<double>& pr) {
   std::vector<double> ts, meas, pn, pc;
@@ -115,7 +115,7 @@ plot::Panel channel_panel(int c, const DiagData& d, const std::vector<std::size_
 
 }  // namespace
 
-plot::Figure residual_vs_regime_figure(const DiagData& d, const ResidualSeries& before, const ResidualSeries& after,
+plot::Figure residual_vs_regime_figure(const PreparedRecording& d, const ResidualSeries& before, const ResidualSeries& after,
                                        const std::vector<char>& mask) {
   const int regimes[] = {0, 3, 4, 1};
   plot::Figure fig("mean residual (measured - predicted) over " + fmt(before.horizon_s) +
@@ -157,7 +157,7 @@ plot::Figure residual_vs_regime_figure(const DiagData& d, const ResidualSeries& 
   return fig;
 }
 
-plot::Figure overlay_figure(const DiagData& d, const ReplayModel& nominal, const ReplayModel& corrected,
+plot::Figure overlay_figure(const PreparedRecording& d, const ReplayModel& nominal, const ReplayModel& corrected,
                             const std::vector<char>& mask, const ReplayOptions& o) {
   plot::Figure fig("held-out part: measured, nominal and corrected open-loop predictions", 1, 1150, 420);
   std::vector<std::size_t> rows;
@@ -188,12 +188,12 @@ plot::Figure overlay_figure(const DiagData& d, const ReplayModel& nominal, const
   return fig;
 }
 
-void plot_residual_vs_regime(const std::string& png, const DiagData& d, const ResidualSeries& before,
+void plot_residual_vs_regime(const std::string& png, const PreparedRecording& d, const ResidualSeries& before,
                              const ResidualSeries& after, const std::vector<char>& mask) {
   residual_vs_regime_figure(d, before, after, mask).write_png(png);
 }
 
-void plot_overlay(const std::string& png, const DiagData& d, const ReplayModel& nominal,
+void plot_overlay(const std::string& png, const PreparedRecording& d, const ReplayModel& nominal,
                   const ReplayModel& corrected, const std::vector<char>& mask, const ReplayOptions& o) {
   overlay_figure(d, nominal, corrected, mask, o).write_png(png);
 }

@@ -14,19 +14,19 @@ namespace mppi::diagnose {
 
 // Grid: rows = channels, columns = speed, steer, throttle, lateral accel; per panel the mean
 // residual per regime bin before (red) and after (blue), on rows in mask (held out).
-plot::Figure residual_vs_regime_figure(const DiagData& d, const ResidualSeries& before, const ResidualSeries& after,
+plot::Figure residual_vs_regime_figure(const PreparedRecording& d, const ResidualSeries& before, const ResidualSeries& after,
                                        const std::vector<char>& mask);
 
 // Top: x-y of the held-out part with 2-s open-loop predictions every 1 s (nominal red,
 // corrected blue, measured black); below: vx and yaw rate against time with the 1-s-ahead
 // predictions. Long series are thinned to about a thousand points.
-plot::Figure overlay_figure(const DiagData& d, const ReplayModel& nominal, const ReplayModel& corrected,
+plot::Figure overlay_figure(const PreparedRecording& d, const ReplayModel& nominal, const ReplayModel& corrected,
                             const std::vector<char>& mask, const ReplayOptions& o);
 
 // The figures written as PNGs.
-void plot_residual_vs_regime(const std::string& png, const DiagData& d, const ResidualSeries& before,
+void plot_residual_vs_regime(const std::string& png, const PreparedRecording& d, const ResidualSeries& before,
                              const ResidualSeries& after, const std::vector<char>& mask);
-void plot_overlay(const std::string& png, const DiagData& d, const ReplayModel& nominal,
+void plot_overlay(const std::string& png, const PreparedRecording& d, const ReplayModel& nominal,
                   const ReplayModel& corrected, const std::vector<char>& mask, const ReplayOptions& o);
 
 }  // namespace mppi::diagnose

@@ -8,23 +8,6 @@
 
 namespace mppi::diagnose {
 
-std::vector<Segment> make_segments(const DiagData& d, const std::vector<char>& mask, int len, int stride) {
-  std::vector<Segment> out;
-  const std::size_t n = d.rows();
-  std::size_t k = 0;
-  while (k + static_cast<std::size_t>(len) < n) {
-    bool ok = d.continuous(k, static_cast<std::size_t>(len));
-    for (int i = 0; ok && !mask.empty() && i <= len; ++i) ok = mask[k + static_cast<std::size_t>(i)] != 0;
-    if (ok) {
-      out.push_back({k, len});
-      k += static_cast<std::size_t>(stride);
-    } else {
-      ++k;
-    }
-  }
-  return out;
-}
-
 namespace {
 
 // How a model reads the recording: a measurement as the true state behind it (the member's
@@ -32,7 +15,7 @@ namespace {
 // offset and the pure delays; a shift by a fraction of a row averages two recorded commands).
 class RecordingView {
  public:
-  RecordingView(const ReplayModel& m, const DiagData& d)
+  RecordingView(const ReplayModel& m, const PreparedRecording& d)
       : d_(d), sf_(m.sensor), inv_scale_(1.0 / m.sensor.speed_scale),
         steer_shift_rows_((m.sensor.time_offset_s + m.command_delay.steer_s) / d.dt_s),
         throttle_shift_rows_((m.sensor.time_offset_s + m.command_delay.throttle_s) / d.dt_s),
@@ -42,8 +25,8 @@ class RecordingView {
   float true_r(std::size_t k) const { return static_cast<float>(d_.r[k] - sf_.gyro_bias_radps); }
   bool roll_at(std::size_t k) const { return has_roll_ && std::isfinite(d_.roll[k]); }
   void command_over(std::size_t k, float* steer, float* throttle) const {
-    *steer = static_cast<float>(shifted(k, steer_shift_rows_, &DiagData::steer_over));
-    *throttle = static_cast<float>(shifted(k, throttle_shift_rows_, &DiagData::throttle_over));
+    *steer = static_cast<float>(shifted(k, steer_shift_rows_, &PreparedRecording::steer_over));
+    *throttle = static_cast<float>(shifted(k, throttle_shift_rows_, &PreparedRecording::throttle_over));
   }
   // The measured states of row k put into a state (element i at x[i * stride]): positions and
   // time as measured, velocities (and roll) blended towards the measurement by `gain`.
@@ -69,21 +52,21 @@ class RecordingView {
   }
 
  private:
-  double shifted(std::size_t k, double shift_rows, double (DiagData::*over)(std::size_t) const) const {
+  double shifted(std::size_t k, double shift_rows, double (PreparedRecording::*over)(std::size_t) const) const {
     if (shift_rows == 0.0) return (d_.*over)(k);
     const double pos = static_cast<double>(k) - shift_rows;
     const double lo = std::floor(pos), w = pos - lo;
     const auto row = [&](double i) { return static_cast<std::size_t>(std::clamp(i, 0.0, static_cast<double>(d_.rows() - 1))); };
     return (1 - w) * (d_.*over)(row(lo)) + w * (d_.*over)(row(lo + 1));
   }
-  const DiagData& d_;
+  const PreparedRecording& d_;
   SensorFaults sf_;
   double inv_scale_, steer_shift_rows_, throttle_shift_rows_;
   bool has_roll_;
 };
 
 // Rows of command history before a start that the priming runs over (those of its own piece).
-int history_rows(const DiagData& d, std::size_t k0, const ReplayOptions& o) {
+int history_rows(const PreparedRecording& d, std::size_t k0, const ReplayOptions& o) {
   const int prime_rows = static_cast<int>(std::lround(o.prime_s / d.dt_s));
   int h = 0;
   while (h < prime_rows && k0 > static_cast<std::size_t>(h) && d.piece[k0 - static_cast<std::size_t>(h) - 1] == d.piece[k0]) ++h;
@@ -99,7 +82,7 @@ int history_rows(const DiagData& d, std::size_t k0, const ReplayOptions& o) {
 // joined, so a recording with timing jitter advances a lane by its own interval only on average.
 class LockstepReplay {
  public:
-  LockstepReplay(const ReplayModel& model, const DiagData& d, const Segment* const* segs, const int* histories,
+  LockstepReplay(const ReplayModel& model, const PreparedRecording& d, const Segment* const* segs, const int* histories,
                  int count, int lanes, const ReplayOptions& o)
       : model_(model), d_(d), view_(model, d), segs_(segs), histories_(histories), count_(count), lanes_(lanes), o_(o),
         nx_(model.states()), time_state_(model.time_index()),
@@ -235,7 +218,7 @@ class LockstepReplay {
   }
 
   const ReplayModel& model_;
-  const DiagData& d_;
+  const PreparedRecording& d_;
   const RecordingView view_;
   const Segment* const* segs_;
   const int* histories_;
@@ -249,21 +232,21 @@ class LockstepReplay {
   bool joined_[L], shares_[L];
 };
 
-void predict_lockstep(const ReplayModel& model, const DiagData& d, const Segment* const* segs, double* const* outs,
+void predict_lockstep(const ReplayModel& model, const PreparedRecording& d, const Segment* const* segs, double* const* outs,
                       const int* histories, int count, int lanes, const ReplayOptions& o) {
   LockstepReplay(model, d, segs, histories, count, lanes, o).run(outs);
 }
 
 }  // namespace
 
-void predict_segment(const ReplayModel& model, const DiagData& d, const Segment& s,
+void predict_segment(const ReplayModel& model, const PreparedRecording& d, const Segment& s,
                      const ReplayOptions& o, double* out) {
   const Segment* seg = &s;
   const int history = history_rows(d, s.start, o);
   predict_lockstep(model, d, &seg, &out, &history, 1, 1, o);
 }
 
-void predict_segments(const ReplayModel& model, const DiagData& d, const std::vector<Segment>& segs,
+void predict_segments(const ReplayModel& model, const PreparedRecording& d, const std::vector<Segment>& segs,
                       const ReplayOptions& o, double* out) {
   // Segments of one length go together, kLanes at a time, longest history first (so that the
   // lanes of a group wait as little as possible for each other); a group of fewer than
@@ -303,7 +286,7 @@ void predict_segments(const ReplayModel& model, const DiagData& d, const std::ve
   }
 }
 
-void segment_residuals(const ReplayModel& model, const DiagData& d,
+void segment_residuals(const ReplayModel& model, const PreparedRecording& d,
                        const std::vector<Segment>& segs, const std::array<double, kChannels>& scale,
                        const ReplayOptions& o, std::vector<double>* res) {
   std::size_t total = 0;
@@ -324,7 +307,7 @@ void segment_residuals(const ReplayModel& model, const DiagData& d,
   }
 }
 
-std::array<double, kChannels> channel_scales(const DiagData& d, const std::vector<char>& mask) {
+std::array<double, kChannels> channel_scales(const PreparedRecording& d, const std::vector<char>& mask) {
   const double floor[kChannels] = {0.05, 0.02, 0.02};
   std::array<double, kChannels> out{};
   for (int c = 0; c < kChannels; ++c) {
@@ -343,14 +326,14 @@ std::array<double, kChannels> channel_scales(const DiagData& d, const std::vecto
   return out;
 }
 
-std::vector<HorizonMetrics> horizon_metrics(const ReplayModel& model, const DiagData& d,
+std::vector<HorizonMetrics> horizon_metrics(const ReplayModel& model, const PreparedRecording& d,
                                             const std::vector<char>& mask,
                                             const std::vector<double>& horizons_s, int stride,
-                                            const ReplayOptions& o, const DiagData* reference) {
+                                            const ReplayOptions& o, const PreparedRecording* reference) {
   if (reference && reference->rows() != d.rows())
     throw Error("horizon_metrics: the reference states have " + std::to_string(reference->rows()) +
                 " rows, the recording " + std::to_string(d.rows()));
-  const DiagData& ref = reference ? *reference : d;
+  const PreparedRecording& ref = reference ? *reference : d;
   std::vector<HorizonMetrics> out;
   const auto scale = channel_scales(d, mask);
   for (double hs : horizons_s) {

@@ -9,16 +9,6 @@
 
 namespace mppi::diagnose {
 
-// Predict rows start+1 .. start+len from the measured state at row start.
-struct Segment {
-  std::size_t start = 0;
-  int len = 0;
-};
-
-// Segments of `len` samples every `stride` rows, fully inside one piece and inside `mask`
-// (mask[k] != 0 for every row used; empty mask = all rows).
-std::vector<Segment> make_segments(const DiagData& d, const std::vector<char>& mask, int len, int stride);
-
 struct ReplayOptions {
   double substep_s = 0.002;  // integration step inside a sample interval [s] (the simulator's)
   double prime_s = 0.6;      // command history run through the actuator chains before a start [s]
@@ -32,7 +22,7 @@ struct ReplayOptions {
 // Predicted vx, vy, yaw rate (and x, y) along a segment: out[(i - 1) * 5 + c] for i = 1..len,
 // c = vx, vy, yaw_rate, x, y.
 inline constexpr int kPredStride = 5;
-void predict_segment(const ReplayModel& model, const DiagData& d, const Segment& s,
+void predict_segment(const ReplayModel& model, const PreparedRecording& d, const Segment& s,
                      const ReplayOptions& o, double* out);
 
 // The same for every segment of `segs`, one after the other in `out` (segment n's predictions
@@ -45,17 +35,17 @@ void predict_segment(const ReplayModel& model, const DiagData& d, const Segment&
 // effect; on a regular one, gaps included, they are the same.
 inline constexpr std::size_t kMinLockstepSegments = 3;
 inline constexpr double kSharedStepTolerance = 0.1;
-void predict_segments(const ReplayModel& model, const DiagData& d, const std::vector<Segment>& segs,
+void predict_segments(const ReplayModel& model, const PreparedRecording& d, const std::vector<Segment>& segs,
                       const ReplayOptions& o, double* out);
 
 // Weighted residuals (prediction - measurement) / scale_c for every sample of every segment,
 // channels vx, vy, yaw_rate; appended to `res` (resized).
-void segment_residuals(const ReplayModel& model, const DiagData& d,
+void segment_residuals(const ReplayModel& model, const PreparedRecording& d,
                        const std::vector<Segment>& segs, const std::array<double, kChannels>& scale,
                        const ReplayOptions& o, std::vector<double>* res);
 
 // Per channel standard deviation of the measured signal over rows in mask (floored).
-std::array<double, kChannels> channel_scales(const DiagData& d, const std::vector<char>& mask);
+std::array<double, kChannels> channel_scales(const PreparedRecording& d, const std::vector<char>& mask);
 
 // Metrics of open-loop prediction at one horizon over starts in `mask` every `stride` rows.
 struct HorizonMetrics {
@@ -68,9 +58,9 @@ struct HorizonMetrics {
 // `reference`, when given, is what predictions are scored against instead of d's own states:
 // the noise-free states of a synthetic recording (same rows as d). Predictions still start from
 // d's (noisy) states; sensor noise on the scored sample, which no model can predict, is left out.
-std::vector<HorizonMetrics> horizon_metrics(const ReplayModel& model, const DiagData& d,
+std::vector<HorizonMetrics> horizon_metrics(const ReplayModel& model, const PreparedRecording& d,
                                             const std::vector<char>& mask,
                                             const std::vector<double>& horizons_s, int stride,
-                                            const ReplayOptions& o, const DiagData* reference = nullptr);
+                                            const ReplayOptions& o, const PreparedRecording* reference = nullptr);
 
 }  // namespace mppi::diagnose

@@ -14,7 +14,7 @@ using json = nlohmann::ordered_json;
 json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 // The values screened out of the recording (screen.hpp); at most kMaxListedFlags listed.
-json screening_json(const DiagData& d) {
+json screening_json(const PreparedRecording& d) {
   json flags = json::array();
   for (std::size_t i = 0; i < d.flags.size() && i < kMaxListedFlags; ++i) {
     const ScreenFlag& f = d.flags[i];
@@ -132,7 +132,7 @@ json test_json(const DiagnoseOptions& o, const DiagnoseResult& res) {
 
 }  // namespace
 
-nlohmann::ordered_json report_json(const DiagData& d, const std::string& nominal_name, const DiagnoseOptions& o,
+nlohmann::ordered_json report_json(const PreparedRecording& d, const std::string& nominal_name, const DiagnoseOptions& o,
                                    const DiagnoseResult& res) {
   json j;
   j["log"] = d.source;

@@ -9,7 +9,7 @@
 
 namespace mppi::diagnose {
 
-nlohmann::ordered_json report_json(const DiagData& d, const std::string& nominal_name, const DiagnoseOptions& o,
+nlohmann::ordered_json report_json(const PreparedRecording& d, const std::string& nominal_name, const DiagnoseOptions& o,
                                    const DiagnoseResult& res);
 
 }  // namespace mppi::diagnose

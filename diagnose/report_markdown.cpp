@@ -9,7 +9,7 @@ namespace mppi::diagnose {
 namespace {
 
 // The recording, the models, the verdict and the headline figures.
-void write_summary(std::ostream& md, const DiagData& d, const std::string& nominal_name, const DiagnoseOptions& o,
+void write_summary(std::ostream& md, const PreparedRecording& d, const std::string& nominal_name, const DiagnoseOptions& o,
                    const DiagnoseResult& res) {
   md << "# Sim-vs-real diagnosis\n\n"
      << "- recording: `" << d.source << "` (" << d.rows() << " rows, dt " << d.dt_s << " s), held out: `" << o.holdout
@@ -37,7 +37,7 @@ void write_summary(std::ostream& md, const DiagData& d, const std::string& nomin
 }
 
 // The values screened out of the recording (screen.hpp); at most kMaxListedFlags listed.
-void write_screened_values(std::ostream& md, const DiagData& d) {
+void write_screened_values(std::ostream& md, const PreparedRecording& d) {
   if (d.flags.empty()) return;
   md << "## Screened values (kept out of the fits)\n\n" << d.flags.size() << " values flagged; "
      << d.screened_rows << " rows dropped with their neighbours.\n\n"
@@ -168,7 +168,7 @@ void write_what_is_left(std::ostream& md, const DiagnoseOptions& o, const Diagno
 
 }  // namespace
 
-std::string report_markdown(const DiagData& d, const std::string& nominal_name, const DiagnoseOptions& o,
+std::string report_markdown(const PreparedRecording& d, const std::string& nominal_name, const DiagnoseOptions& o,
                             const DiagnoseResult& res, double residual_horizon_s) {
   std::ostringstream md;
   md.precision(4);

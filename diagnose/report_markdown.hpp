@@ -13,7 +13,7 @@ namespace mppi::diagnose {
 inline constexpr std::size_t kMaxListedFlags = 200;
 
 // residual_horizon_s: the horizon of the locating residuals (the mismatch table's predictions).
-std::string report_markdown(const DiagData& d, const std::string& nominal_name, const DiagnoseOptions& o,
+std::string report_markdown(const PreparedRecording& d, const std::string& nominal_name, const DiagnoseOptions& o,
                             const DiagnoseResult& res, double residual_horizon_s);
 
 }  // namespace mppi::diagnose

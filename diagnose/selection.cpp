@@ -19,7 +19,7 @@ namespace mppi::diagnose {
 using namespace selection;
 namespace {
 
-double heldout_1s_normalized_rmse(const ReplayModel& m, const DiagData& d, const std::vector<char>& mask,
+double heldout_1s_normalized_rmse(const ReplayModel& m, const PreparedRecording& d, const std::vector<char>& mask,
                                   const ReplayOptions& o) {
   return horizon_metrics(m, d, mask, {1.0}, 5, o)[0].normalized_rmse;
 }
@@ -28,7 +28,7 @@ double heldout_1s_normalized_rmse(const ReplayModel& m, const DiagData& d, const
 // the earlier stages found.
 class SelectionRun {
  public:
-  SelectionRun(const DiagData& d, const ModelFamily& nominal, const std::vector<char>& train_mask,
+  SelectionRun(const PreparedRecording& d, const ModelFamily& nominal, const std::vector<char>& train_mask,
                const std::vector<char>& heldout_mask, const SelectionOptions& opt, const ReplayOptions& replay)
       : d_(d),
         nominal_(nominal),
@@ -65,7 +65,7 @@ class SelectionRun {
 
   // Candidates this recording can identify at all (the rest are "not testable").
   void testable_pool() {
-    const DiagData& d = d_;
+    const PreparedRecording& d = d_;
     const std::vector<char>& train_mask = train_mask_;
     std::vector<int>& pool = pool_;
     const ExcitationLevels excitation = measure_excitation(d, train_mask);
@@ -310,7 +310,7 @@ class SelectionRun {
   // The held-out part decides whether the correction is trusted; false: it is not (the verdict
   // says so and nothing is named).
   bool heldout_veto(const std::vector<std::string>& named) {
-    const DiagData& d = d_;
+    const PreparedRecording& d = d_;
     const double held_nominal = held_nominal_;
     char line[512];
     sel_.heldout_nominal = held_nominal;
@@ -355,7 +355,7 @@ class SelectionRun {
     log_.push_back(sel_.verdict);
   }
 
-  const DiagData& d_;
+  const PreparedRecording& d_;
   const ModelFamily& nominal_;
   const std::vector<char>& train_mask_;
   const std::vector<char>& heldout_mask_;
@@ -380,7 +380,7 @@ class SelectionRun {
 
 }  // namespace
 
-Selection select_effects(const DiagData& d, const ModelFamily& nominal, const std::vector<char>& train_mask,
+Selection select_effects(const PreparedRecording& d, const ModelFamily& nominal, const std::vector<char>& train_mask,
                          const std::vector<char>& heldout_mask, const SelectionOptions& opt,
                          const ReplayOptions& replay) {
   return SelectionRun(d, nominal, train_mask, heldout_mask, opt, replay).run();

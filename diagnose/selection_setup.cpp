@@ -10,7 +10,7 @@
 namespace mppi::diagnose::selection {
 
 
-void make_problems(const DiagData& d, const ModelFamily& nominal, const std::vector<char>& train_mask,
+void make_problems(const PreparedRecording& d, const ModelFamily& nominal, const std::vector<char>& train_mask,
                    const SelectionOptions& opt, const ReplayOptions& replay, Problems* p, SelectionLog& log) {
   FitProblem& all = p->all;
   FitProblem& fit = p->fit;

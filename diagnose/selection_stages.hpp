@@ -86,7 +86,7 @@ struct Problems {
   double n_eff = 0;  // the fit part's effective sample count (the BIC's)
 };
 
-void make_problems(const DiagData& d, const ModelFamily& nominal, const std::vector<char>& train_mask,
+void make_problems(const PreparedRecording& d, const ModelFamily& nominal, const std::vector<char>& train_mask,
                    const SelectionOptions& opt, const ReplayOptions& replay, Problems* p, SelectionLog& log);
 
 // The candidates: the library's (or those asked for) that the nominal model takes, then the joint

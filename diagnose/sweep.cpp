@@ -46,8 +46,8 @@ std::string percent(int n, int of) {
 SweepRun run_sweep_case(const SynthOptions& so, const std::string& csv, const DiagnoseOptions& o,
                         const std::string& truth_label, const std::string& size) {
   if (!std::filesystem::exists(csv)) synthesize(so, csv);
-  const DiagData d = load_recording(csv);
-  const DiagData clean = load_recording(so.work_dir + "/run/log.csv");  // the noise-free states
+  const PreparedRecording d = load_recording(csv);
+  const PreparedRecording clean = load_recording(so.work_dir + "/run/log.csv");  // the noise-free states
   const auto family = make_model_family(so.nominal_model);
   const DiagnoseResult r = run_diagnosis(d, *family, o);
 

@@ -2,7 +2,7 @@
 // (diagnose/data.cpp: columns, pieces, sample interval).
 #include <sstream>
 
-#include "diagnose/data.hpp"
+#include "sysid/prepared_recording.hpp"
 #include "fuzz/fuzz_input.hpp"
 #include "sim/recording.hpp"
 
@@ -11,7 +11,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     std::istringstream in(mppi::fuzz::as_text(data, size));
     const mppi::sim::Recording rec = mppi::sim::RecordingReader::read(in, "fuzz.csv");
     // Any minimum row count, down to 0, must be safe.
-    mppi::diagnose::prepare(rec, "fuzz.csv", /*min_rows=*/size % 4);
+    mppi::sysid::prepare(rec, "fuzz.csv", /*min_rows=*/size % 4);
   });
   return 0;
 }

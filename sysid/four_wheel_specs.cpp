@@ -60,7 +60,7 @@ VehicleModelSpec double_track_spec(const DoubleTrackParams& base, const std::vec
     });
   };
   const double radius = base.base.wheel_radius_m;
-  s.init_state = [radius](const sim::Recording& rec, std::size_t row, double* x) {
+  s.init_state = [radius](const PreparedRecording& rec, std::size_t row, double* x) {
     const char* cols[11] = {"x", "y", "yaw", "vx", "vy", "yaw_rate", "roll", "omega_lf", "omega_rf",
                             "omega_lr", "omega_rr"};
     for (int i = 0; i < 6; ++i) x[i] = detail::value_or(rec, cols[i], row, 0.0);
@@ -99,7 +99,7 @@ VehicleModelSpec full_vehicle_spec(const FullVehicleParams& base, const std::vec
     detail::substep(dt, 0.002, [&](double h) { FullVehicle::step_double(k, x, u, h); });
   };
   const double radius = base.base.wheel_radius_m;
-  s.init_state = [radius](const sim::Recording& rec, std::size_t row, double* x) {
+  s.init_state = [radius](const PreparedRecording& rec, std::size_t row, double* x) {
     const char* cols[16] = {"x", "y", "yaw", "vx", "vy", "yaw_rate", "roll", "omega_lf", "omega_rf",
                             "omega_lr", "omega_rr", "pitch", "heave", "roll_rate", "pitch_rate", "vz"};
     for (int i = 0; i < 16; ++i) x[i] = detail::value_or(rec, cols[i], row, 0.0);

@@ -24,9 +24,6 @@ struct RolloutPlan {
   int steps = 0;                    // samples predicted per rollout (leads 1..steps)
   std::vector<int> state_index;     // per channel
   std::vector<const std::vector<double>*> measured;
-  const std::vector<double>* t = nullptr;
-  const std::vector<double>* steer = nullptr;
-  const std::vector<double>* throttle = nullptr;
   double dt_s = 0;                  // the recording's sample interval (median step)
 };
 
@@ -37,13 +34,10 @@ double sample_interval_s(const std::vector<double>& t) {
   return steps[steps.size() / 2];
 }
 
-RolloutPlan make_plan(const VehicleModelSpec& spec, const sim::Recording& rec, const PredictionErrorOptions& o) {
+RolloutPlan make_plan(const VehicleModelSpec& spec, const PreparedRecording& rec, const PredictionErrorOptions& o) {
   std::string why;
   if (!o.is_valid(&why)) throw Error("prediction error: " + why);
   RolloutPlan p;
-  p.t = &rec.column("t");
-  p.steer = &rec.column("steer");
-  p.throttle = &rec.column("throttle");
   for (const auto& c : o.channels) {
     auto it = std::find_if(spec.measurable.begin(), spec.measurable.end(),
                            [&](const auto& m) { return m.first == c; });
@@ -54,25 +48,21 @@ RolloutPlan make_plan(const VehicleModelSpec& spec, const sim::Recording& rec, c
   }
   const std::size_t n = rec.rows();
   if (n < 3) throw Error("prediction error: the recording has fewer than 3 rows");
-  p.dt_s = sample_interval_s(*p.t);
+  p.dt_s = rec.dt_s;
   p.steps = std::max(1, static_cast<int>(std::lround(o.horizon_s / p.dt_s)));
-  const std::size_t stride = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(o.stride_s / p.dt_s)));
-  // A rollout never spans a gap (a dropout, or the seam between joined recordings): its
-  // window, and the sample before it (the actuators' last command), must last no longer than
-  // their samples at the recording's interval.
-  const auto steps = static_cast<std::size_t>(p.steps);
-  const auto& t = *p.t;
-  if (steps >= n) throw Error("prediction error: the recording is shorter than one horizon");
-  for (std::size_t s = 0; s + steps < n; s += stride) {
-    const bool after_gap = s > 0 && t[s] - t[s - 1] > 1.5 * p.dt_s;
-    if (!after_gap && t[s + steps] - t[s] <= (static_cast<double>(steps) + 0.5) * p.dt_s) p.starts.push_back(s);
-  }
+  const int stride = std::max(1, static_cast<int>(std::lround(o.stride_s / p.dt_s)));
+  if (static_cast<std::size_t>(p.steps) >= n) throw Error("prediction error: the recording is shorter than one horizon");
+  // A rollout stays inside one continuous piece of the recording (no gap, no seam between joined
+  // recordings, no screened-out value): the segments of a prepared recording. None starts on a
+  // piece's first row, where the command before the start (the actuators' state) is not known.
+  for (const Segment& s : make_segments(rec, {}, p.steps, stride))
+    if (s.start > 0 && rec.continuous(s.start - 1, 1)) p.starts.push_back(s.start);
   if (p.starts.empty()) throw Error("prediction error: the recording has no gap-free stretch of one horizon");
   return p;
 }
 
 // Normalised residuals, [rollout][lead 1..steps][channel] flattened; NaN where not recorded.
-void residuals(const VehicleModelSpec& spec, const std::vector<double>& values, const sim::Recording& rec,
+void residuals(const VehicleModelSpec& spec, const std::vector<double>& values, const PreparedRecording& rec,
                const RolloutPlan& p, const std::vector<double>& scales, std::vector<double>& out) {
   const std::size_t nc = p.state_index.size();
   out.assign(p.starts.size() * static_cast<std::size_t>(p.steps) * nc, 0.0);
@@ -85,8 +75,8 @@ void residuals(const VehicleModelSpec& spec, const std::vector<double>& values, 
     for (int lead = 1; lead <= p.steps; ++lead) {
       const std::size_t i = s + static_cast<std::size_t>(lead);
       if (!diverged) {
-        const double u[2] = {(*p.steer)[i - 1], (*p.throttle)[i - 1]};
-        spec.step(values, x.data(), u, (*p.t)[i] - (*p.t)[i - 1]);
+        const double u[2] = {rec.steer_over(i - 1), rec.throttle_over(i - 1)};
+        spec.step(values, x.data(), u, rec.t[i] - rec.t[i - 1]);
         for (double v : x) diverged = diverged || !std::isfinite(v);
       }
       for (std::size_t c = 0; c < nc; ++c, ++k) {
@@ -132,7 +122,7 @@ bool CalibrationOptions::is_valid(std::string* why) const {
   return true;
 }
 
-std::vector<double> channel_scales(const sim::Recording& rec, const std::vector<std::string>& channels) {
+std::vector<double> channel_scales(const PreparedRecording& rec, const std::vector<std::string>& channels) {
   std::vector<double> out;
   for (const auto& c : channels) {
     double s = 0, s2 = 0;
@@ -152,7 +142,7 @@ std::vector<double> channel_scales(const sim::Recording& rec, const std::vector<
 }
 
 PredictionError prediction_error(const VehicleModelSpec& spec, const std::vector<double>& values,
-                                 const sim::Recording& rec, const std::vector<double>& scales,
+                                 const PreparedRecording& rec, const std::vector<double>& scales,
                                  const PredictionErrorOptions& o) {
   const RolloutPlan p = make_plan(spec, rec, o);
   const std::size_t nc = p.state_index.size();
@@ -317,7 +307,7 @@ Eigen::VectorXd search_start(const VehicleModelSpec& spec, const LeastSquaresPro
 
 }  // namespace
 
-CalibrationResult calibrate(const VehicleModelSpec& spec, const sim::Recording& rec, const std::vector<double>& scales,
+CalibrationResult calibrate(const VehicleModelSpec& spec, const PreparedRecording& rec, const std::vector<double>& scales,
                             const CalibrationOptions& o, std::vector<double> initial) {
   std::string why;
   if (!o.is_valid(&why)) throw Error("calibrate: " + why);

@@ -3,7 +3,9 @@
 // every `stride_s` a rollout of `horizon_s` starts from the recorded state and is driven by
 // the recorded commands; the residuals are the predicted minus recorded channels (body
 // velocities and yaw rate by default), each divided by the channel's standard deviation in
-// the recording (normalised RMSE). The fit is Levenberg-Marquardt with a forward-difference
+// the recording (normalised RMSE). The recording is the prepared one (sysid/prepared_recording.hpp)
+// that the diagnosis also replays: its pieces say where a rollout may run, and its command timing
+// which command acts over each sample interval. The fit is Levenberg-Marquardt with a forward-difference
 // Jacobian over the parameters a VehicleModelSpec exposes (positive ones in log space), kept
 // inside a box (base/least_squares.hpp). docs/CALIBRATION.md.
 #include <string>
@@ -37,23 +39,23 @@ struct PredictionError {
 
 // Standard deviation of each column over the recording (finite values); throws mppi::Error
 // for a missing column or one that is constant.
-std::vector<double> channel_scales(const sim::Recording& rec, const std::vector<std::string>& channels);
+std::vector<double> channel_scales(const PreparedRecording& rec, const std::vector<std::string>& channels);
 
 // Prediction error of the model with `values` on `rec`, normalised by `scales` (one per
 // channel). Throws mppi::Error for a channel the model does not measure, invalid options, or
-// a recording with no gap-free stretch of one horizon. Rollouts start every stride_s
-// except where their window would span a gap in t (longer than the median sample interval
-// allows). A rollout that goes non-finite counts with residual
+// a recording with no gap-free stretch of one horizon. Rollouts start every stride_s inside the
+// recording's continuous pieces (make_segments): none spans a gap, a seam between joined
+// recordings or a screened-out value. A rollout that goes non-finite counts with residual
 // 10 (normalised) from then on.
 PredictionError prediction_error(const VehicleModelSpec& spec, const std::vector<double>& values,
-                                 const sim::Recording& rec, const std::vector<double>& scales,
+                                 const PreparedRecording& rec, const std::vector<double>& scales,
                                  const PredictionErrorOptions& options = {});
 
 // Recordings joined end to end into one, for a fit or a judgement over several: the columns
 // every piece has (in the first one's order), each later piece shifted in time to start
 // `gap_s` after the previous one ends. prediction_error() starts no rollout across a gap, and
 // a gap longer than 1 s keeps the actuator priming (1 s of command history) from reaching
-// across it. Throws mppi::Error for no pieces, a piece with fewer than 2 rows, pieces
+// across it. prepare() the result before fitting to it. Throws mppi::Error for no pieces, a piece with fewer than 2 rows, pieces
 // sampled at different intervals (more than 1 % apart), or gap_s <= 1.
 sim::Recording join_recordings(const std::vector<sim::Recording>& pieces, double gap_s = 10.0);
 
@@ -103,7 +105,7 @@ struct CalibrationResult {
 // Fits spec's estimated parameters, starting from `initial` (default: spec.nominal), to
 // minimise the mean squared normalised prediction residual on `rec` with `scales`. A lag
 // (steer_lag_s, throttle_lag_s) that would start at 0, where it has no derivative, starts at 0.05 s.
-CalibrationResult calibrate(const VehicleModelSpec& spec, const sim::Recording& rec,
+CalibrationResult calibrate(const VehicleModelSpec& spec, const PreparedRecording& rec,
                             const std::vector<double>& scales, const CalibrationOptions& options = {},
                             std::vector<double> initial = {});
 

@@ -61,7 +61,7 @@ decltype(VehicleModelSpec::step) single_track_step(const SingleTrackWith& with, 
 }
 
 decltype(VehicleModelSpec::init_state) single_track_init_state(double radius, bool actuators) {
-  return [radius, actuators](const sim::Recording& rec, std::size_t row, double* x) {
+  return [radius, actuators](const PreparedRecording& rec, std::size_t row, double* x) {
     const char* cols[6] = {"x", "y", "yaw", "vx", "vy", "yaw_rate"};
     for (int i = 0; i < 6; ++i) x[i] = detail::value_or(rec, cols[i], row, 0.0);
     x[6] = 0;
@@ -69,26 +69,24 @@ decltype(VehicleModelSpec::init_state) single_track_init_state(double radius, bo
     x[7] = detail::value_or(rec, "omega_front", row, w);
     x[8] = detail::value_or(rec, "omega_rear", row, w);
     if (actuators) {  // steady at the last command until prime() runs the history through them
-      x[SingleTrack::kNx] = row > 0 ? rec.column("steer")[row - 1] : 0.0;
-      x[SingleTrack::kNx + 1] = row > 0 ? rec.column("throttle")[row - 1] : 0.0;
+      x[SingleTrack::kNx] = row > 0 ? rec.steer_over(row - 1) : 0.0;
+      x[SingleTrack::kNx + 1] = row > 0 ? rec.throttle_over(row - 1) : 0.0;
     }
   };
 }
 
 // The actuator lags run over the commands of the kActuatorPrime_s before `row`.
 decltype(VehicleModelSpec::prime) single_track_prime(const SingleTrackWith& with) {
-  return [with](const std::vector<double>& v, const sim::Recording& rec, std::size_t row, double* x) {
+  return [with](const std::vector<double>& v, const PreparedRecording& rec, std::size_t row, double* x) {
     const SingleTrackWithActuators p = with(v);
-    const auto& t = rec.column("t");
-    const auto& steer = rec.column("steer");
-    const auto& throttle = rec.column("throttle");
+    const auto& t = rec.t;
     std::size_t first = row;
     while (first > 0 && t[row] - t[first - 1] <= detail::kActuatorPrime_s) --first;
     if (first == row) return;
-    x[SingleTrack::kNx] = steer[first];
-    x[SingleTrack::kNx + 1] = throttle[first];
+    x[SingleTrack::kNx] = rec.steer_over(first);
+    x[SingleTrack::kNx + 1] = rec.throttle_over(first);
     for (std::size_t i = first; i < row; ++i) {
-      const double u[2] = {steer[i], throttle[i]};
+      const double u[2] = {rec.steer_over(i), rec.throttle_over(i)};
       detail::advance_actuators(p.act, u, t[i + 1] - t[i], x + SingleTrack::kNx);
     }
   };

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "base/error.hpp"
-#include "sim/recording.hpp"
+#include "sysid/prepared_recording.hpp"
 #include "sysid/model_param_fields.hpp"
 #include "sysid/vehicle_model_spec.hpp"
 
@@ -45,9 +45,10 @@ void substep(double dt, double max_sub, StepFn&& fn) {
   for (int i = 0; i < n; ++i) fn(dt / n);
 }
 
-inline double value_or(const sim::Recording& rec, const char* col, std::size_t row, double fallback) {
-  if (!rec.has_column(col)) return fallback;
-  const double v = rec.column(col)[row];
+inline double value_or(const PreparedRecording& rec, const char* col, std::size_t row, double fallback) {
+  const std::vector<double>* c = rec.find_column(col);
+  if (!c) return fallback;
+  const double v = (*c)[row];
   return std::isfinite(v) ? v : fallback;
 }
 

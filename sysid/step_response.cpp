@@ -33,12 +33,13 @@ std::vector<double> steering_step_yaw_rate(const VehicleModelSpec& spec, const s
   rec.columns = {"t", "x", "y", "yaw", "vx", "vy", "yaw_rate", "steer", "throttle"};
   rec.data.assign(rec.columns.size(), {});
   for (int i = 0; i <= before; ++i) {
-    const double row[9] = {i * dt_s, 0, 0, 0, speed_mps, 0, 0, i < before ? 0.0 : steer, throttle};
+    const double row[9] = {i * dt_s, speed_mps * i * dt_s, 0, 0, speed_mps, 0, 0, i < before ? 0.0 : steer, throttle};
     for (std::size_t c = 0; c < 9; ++c) rec.data[c].push_back(row[c]);
   }
+  const PreparedRecording prepared = prepare(rec, "steering step", 2);
   std::vector<double> x(static_cast<std::size_t>(spec.nx));
-  spec.init_state(rec, static_cast<std::size_t>(before), x.data());
-  if (spec.prime) spec.prime(values, rec, static_cast<std::size_t>(before), x.data());
+  spec.init_state(prepared, static_cast<std::size_t>(before), x.data());
+  if (spec.prime) spec.prime(values, prepared, static_cast<std::size_t>(before), x.data());
   const auto m = std::find_if(spec.measurable.begin(), spec.measurable.end(),
                               [](const auto& c) { return c.first == "yaw_rate"; });
   if (m == spec.measurable.end()) throw Error("steering step: the " + spec.kind + " model has no yaw rate");

@@ -70,7 +70,7 @@ struct MeasuredChannels {
   std::vector<const std::vector<double>*> columns;
 };
 
-MeasuredChannels measured_channels(const VehicleModelSpec& spec, const sim::Recording& rec,
+MeasuredChannels measured_channels(const VehicleModelSpec& spec, const PreparedRecording& rec,
                                    const EstimateSettings& st) {
   MeasuredChannels out;
   for (const auto& [col, idx] : spec.measurable) {
@@ -122,7 +122,7 @@ struct FilterStart {
   Mat Pp0, Px0, Qx, R;
 };
 
-FilterStart filter_start(const VehicleModelSpec& spec, const sim::Recording& rec, const EstimateSettings& st,
+FilterStart filter_start(const VehicleModelSpec& spec, const PreparedRecording& rec, const EstimateSettings& st,
                          const std::vector<double>& init, const std::vector<std::string>& measured,
                          std::size_t first_row, double dt_med) {
   const int np = static_cast<int>(spec.estimated.size()), nx = spec.nx, ny = static_cast<int>(measured.size());
@@ -178,14 +178,12 @@ void record_params(const JointStateFilter& filt, const std::vector<bool>& logs, 
 
 }  // namespace
 
-EstimateResult estimate_parameters(const VehicleModelSpec& spec, const sim::Recording& rec,
+EstimateResult estimate_parameters(const VehicleModelSpec& spec, const PreparedRecording& rec,
                                    const EstimateSettings& st, const std::vector<double>& initial_values) {
   std::string why;
   if (!st.is_valid(&why)) throw Error("estimate settings: " + why);
   const auto t0_wall = std::chrono::steady_clock::now();
-  const auto& t = rec.column("t");
-  const auto& steer = rec.column("steer");
-  const auto& throttle = rec.column("throttle");
+  const auto& t = rec.t;
   const std::vector<std::size_t> rows = fit_rows(t, st);
   const MeasuredChannels measured = measured_channels(spec, rec, st);
   EstimateResult res;
@@ -206,8 +204,8 @@ EstimateResult estimate_parameters(const VehicleModelSpec& spec, const sim::Reco
   for (std::size_t k = 1; k < rows.size(); ++k) {
     const std::size_t prev = rows[k - 1], cur = rows[k];
     Vec u_prev(3), u(3), y(ny);
-    u_prev << steer[prev], throttle[prev], t[cur] - t[prev];
-    u << steer[cur], throttle[cur], 0.0;
+    u_prev << rec.steer_over(prev), rec.throttle_over(prev), t[cur] - t[prev];
+    u << rec.steer_over(cur), rec.throttle_over(cur), 0.0;
     if (!std::isfinite(u_prev(0))) u_prev(0) = 0;
     if (!std::isfinite(u_prev(1))) u_prev(1) = 0;
     for (int i = 0; i < ny; ++i) y(i) = (*measured.columns[i])[cur];
@@ -244,15 +242,13 @@ double convergence_time(const EstimateResult& r, std::size_t param, double band)
 }
 
 ValidationResult validate_parameters(const VehicleModelSpec& spec, const std::vector<double>& values,
-                                     const sim::Recording& rec, std::size_t begin, std::size_t end,
+                                     const PreparedRecording& rec, std::size_t begin, std::size_t end,
                                      double horizon_s) {
   ValidationResult v;
   v.channels = {"x", "y", "yaw", "vx", "vy", "yaw_rate"};
   end = std::min(end, rec.rows());
   if (end < begin + 2) throw Error("validate: fewer than 2 rows");
-  const auto& t = rec.column("t");
-  const auto& steer = rec.column("steer");
-  const auto& throttle = rec.column("throttle");
+  const auto& t = rec.t;
   std::vector<const std::vector<double>*> meas;
   for (const auto& c : v.channels) meas.push_back(&rec.column(c));
   const int nc = static_cast<int>(v.channels.size());
@@ -282,7 +278,8 @@ ValidationResult validate_parameters(const VehicleModelSpec& spec, const std::ve
       }
       if (open_loop) v.t.push_back(t[i]);
       if (i + 1 < end) {
-        const double u[2] = {std::isfinite(steer[i]) ? steer[i] : 0.0, std::isfinite(throttle[i]) ? throttle[i] : 0.0};
+        const double steer = rec.steer_over(i), throttle = rec.throttle_over(i);
+        const double u[2] = {std::isfinite(steer) ? steer : 0.0, std::isfinite(throttle) ? throttle : 0.0};
         spec.step(values, x.data(), u, t[i + 1] - t[i]);
       }
     }

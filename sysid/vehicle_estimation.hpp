@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "sim/recording.hpp"
+#include "sysid/prepared_recording.hpp"
 #include "sysid/alm_ukf.hpp"
 #include "sysid/vehicle_model_spec.hpp"
 
@@ -48,7 +48,7 @@ struct EstimateResult {
 
 // Runs the joint-state filter over the fit rows. Throws mppi::Error for a recording that
 // lacks a required column, or has too few rows.
-EstimateResult estimate_parameters(const VehicleModelSpec& spec, const sim::Recording& rec,
+EstimateResult estimate_parameters(const VehicleModelSpec& spec, const PreparedRecording& rec,
                                    const EstimateSettings& settings,
                                    const std::vector<double>& initial_values = {});
 
@@ -72,7 +72,7 @@ struct ValidationResult {
 // Simulates the model with `values` over rows [begin, end) of `rec` with the recorded
 // controls, open loop from the measured state of the first row, and in horizon_s chunks.
 ValidationResult validate_parameters(const VehicleModelSpec& spec, const std::vector<double>& values,
-                                     const sim::Recording& rec, std::size_t begin, std::size_t end,
+                                     const PreparedRecording& rec, std::size_t begin, std::size_t end,
                                      double horizon_s = 1.0);
 
 }  // namespace mppi::sysid

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "dynamics/vehicle_params.hpp"
-#include "sim/recording.hpp"
+#include "sysid/prepared_recording.hpp"
 
 namespace mppi::sysid {
 
@@ -29,10 +29,10 @@ struct VehicleModelSpec {
   // x <- x after dt with the estimated parameters set to `values` (others from the base).
   std::function<void(const std::vector<double>& values, double* x, const double* u, double dt)> step;
   // A full state from a recording row (unmeasured states from the measured ones).
-  std::function<void(const sim::Recording& rec, std::size_t row, double* x)> init_state;
+  std::function<void(const PreparedRecording& rec, std::size_t row, double* x)> init_state;
   // Optional, after init_state: states that depend on the parameters and the command history
   // before `row` (the single-track's actuator lags, run over the preceding commands).
-  std::function<void(const std::vector<double>& values, const sim::Recording& rec, std::size_t row, double* x)>
+  std::function<void(const std::vector<double>& values, const PreparedRecording& rec, std::size_t row, double* x)>
       prime;
   // The base parameters with `values` set, as a YAML file the simulator/controller loads.
   std::function<std::string(const std::vector<double>& values)> to_yaml;

@@ -9,7 +9,7 @@
 
 #include <vector>
 
-#include "diagnose/data.hpp"
+#include "sysid/prepared_recording.hpp"
 #include "diagnose/model_family.hpp"
 #include "diagnose/replay.hpp"
 #include "diagnose/synth.hpp"
@@ -18,7 +18,7 @@ namespace {
 
 void BM_ReplaySegments(benchmark::State& state) {
   using namespace mppi::diagnose;
-  static const DiagData d = prepare(synthesize_open_loop({}, 7, 80.0), "bench drive");
+  static const PreparedRecording d = prepare(synthesize_open_loop({}, 7, 80.0), "bench drive");
   mppi::EffectParams e;
   e.steer_lag_s = 0.08;
   e.patch_x_m = 10;

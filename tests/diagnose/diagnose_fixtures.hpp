@@ -7,7 +7,7 @@
 #include <system_error>
 #include <vector>
 
-#include "diagnose/data.hpp"
+#include "sysid/prepared_recording.hpp"
 #include "diagnose/diagnose.hpp"
 #include "diagnose/fit.hpp"
 #include "diagnose/model_family.hpp"
@@ -18,7 +18,7 @@
 namespace mppi::test {
 
 // Training problem over the whole recording: 0.5 s segments, the built-in single-track nominal.
-inline diagnose::FitProblem training_problem(const diagnose::DiagData& d) {
+inline diagnose::FitProblem training_problem(const diagnose::PreparedRecording& d) {
   static const auto family = diagnose::make_model_family("single-track");
   diagnose::FitProblem p;
   p.data = &d;
@@ -76,7 +76,7 @@ class ScratchDir {
 inline diagnose::DiagnoseResult diagnose_independent(const evidence::EvidenceResult& rec,
                                                      diagnose::DiagnoseOptions opt = {}) {
   opt.plots = false;
-  const diagnose::DiagData d = diagnose::load_recording(rec.csv);
+  const diagnose::PreparedRecording d = diagnose::load_recording(rec.csv);
   return diagnose::run_diagnosis(d, *diagnose::make_model_family("single-track", rec.vehicle_yaml), opt);
 }
 

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "diagnose/candidate_effects.hpp"
-#include "diagnose/data.hpp"
+#include "sysid/prepared_recording.hpp"
 #include "diagnose/diagnose.hpp"
 #include "diagnose/joint_refit.hpp"
 #include "diagnose/model_family.hpp"
@@ -132,11 +132,11 @@ TEST_CASE("a steering delay chosen as a lag before the drag was in the model is 
 }
 
 TEST_CASE("a parameter at the end of its range in the joint refit is held at its nominal value", "[diagnose]") {
-  auto problem = [](const DiagData& d) { return mppi::test::training_problem(d); };
+  auto problem = [](const PreparedRecording& d) { return mppi::test::training_problem(d); };
   SECTION("one grade beyond the search range: held at 0, the other grade refitted") {
     EffectParams truth;
     parse_effect_assignments("grade_x=0.06,grade_y=0.4", &truth);  // dz/dy beyond the search range [-0.3, 0.3]
-    const DiagData d = prepare(synthesize_open_loop(truth, 11, 30.0), "a grade beyond its range");
+    const PreparedRecording d = prepare(synthesize_open_loop(truth, 11, 30.0), "a grade beyond its range");
     const FitProblem p = problem(d);
     EffectParams start;
     start.grade_x = 0.02;
@@ -158,7 +158,7 @@ TEST_CASE("a parameter at the end of its range in the joint refit is held at its
   SECTION("both grades inside the range: both fitted, nothing held (oracle: the truth)") {
     EffectParams truth;
     parse_effect_assignments("grade_x=0.06,grade_y=-0.04", &truth);
-    const DiagData d = prepare(synthesize_open_loop(truth, 11, 30.0), "grades inside their range");
+    const PreparedRecording d = prepare(synthesize_open_loop(truth, 11, 30.0), "grades inside their range");
     EffectParams start;
     start.grade_x = 0.02;
     start.grade_y = 0.0;
@@ -171,7 +171,7 @@ TEST_CASE("a parameter at the end of its range in the joint refit is held at its
   SECTION("a one-parameter effect at its bound has nothing else to fit: not identified") {
     EffectParams truth;
     parse_effect_assignments("aero_drag_kgpm=4", &truth);  // beyond the search range [-0.05, 3]
-    const DiagData d = prepare(synthesize_open_loop(truth, 11, 30.0), "drag beyond its range");
+    const PreparedRecording d = prepare(synthesize_open_loop(truth, 11, 30.0), "drag beyond its range");
     EffectParams start;
     start.aero_drag_kgpm = 1;
     const JointRefit j = refit_named_jointly(problem(d), {"aero_drag"}, start, 0.01);

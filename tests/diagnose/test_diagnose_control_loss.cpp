@@ -7,7 +7,7 @@
 #include <string>
 
 #include "diagnose/control_loss.hpp"
-#include "diagnose/data.hpp"
+#include "sysid/prepared_recording.hpp"
 #include "diagnose/diagnose.hpp"
 #include "diagnose/model_family.hpp"
 #include "evidence/generator.hpp"
@@ -19,8 +19,8 @@ using namespace mppi::diagnose;
 
 namespace {
 
-DiagData straight_at(double vx_mps, std::size_t rows) {
-  DiagData d;
+PreparedRecording straight_at(double vx_mps, std::size_t rows) {
+  PreparedRecording d;
   d.dt_s = 0.02;
   for (std::size_t k = 0; k < rows; ++k) {
     d.t.push_back(0.02 * static_cast<double>(k));
@@ -33,7 +33,7 @@ DiagData straight_at(double vx_mps, std::size_t rows) {
 }  // namespace
 
 TEST_CASE("rows of lost control: body slip above the limit at speed, with a guard either side", "[diagnose]") {
-  DiagData d = straight_at(5.0, 300);
+  PreparedRecording d = straight_at(5.0, 300);
   for (std::size_t k = 100; k < 105; ++k) d.vy[k] = 10.0;  // atan(10 / 5) = 63 deg: a spin
   for (std::size_t k = 200; k < 210; ++k) {               // reversing with a little slip: 5.7 deg
     d.vx[k] = -5.0;
@@ -63,7 +63,7 @@ TEST_CASE("rows of lost control: body slip above the limit at speed, with a guar
 }
 
 TEST_CASE("lost-control options out of range are refused by name", "[diagnose]") {
-  DiagData d = straight_at(5.0, 100);
+  PreparedRecording d = straight_at(5.0, 100);
   d.source = "drive.csv";
   const auto refused = [&](double slip_deg, double speed_mps, double guard_s) {
     ControlLossOptions o;

@@ -12,7 +12,7 @@
 #include "dynamics/with_effects.hpp"
 #include "dynamics/single_track.hpp"
 #include "base/error.hpp"
-#include "diagnose/data.hpp"
+#include "sysid/prepared_recording.hpp"
 #include "diagnose/candidate_effects.hpp"
 #include "diagnose/fit.hpp"
 #include "diagnose/synth.hpp"
@@ -23,7 +23,7 @@ using namespace mppi::diagnose;
 
 namespace {
 
-FitProblem problem_for(const DiagData& d) { return mppi::test::training_problem(d); }
+FitProblem problem_for(const PreparedRecording& d) { return mppi::test::training_problem(d); }
 
 double value_of(const FitResult& r, const std::string& name) {
   for (const auto& p : r.params)
@@ -115,7 +115,7 @@ TEST_CASE("each candidate effect's fit recovers the truth it was generated with"
     SECTION(c.id) {
       EffectParams truth;
       parse_effect_assignments(c.truth, &truth);
-      const DiagData d = prepare(synthesize_open_loop(truth, 11, 30.0), c.id);
+      const PreparedRecording d = prepare(synthesize_open_loop(truth, 11, 30.0), c.id);
       const FitProblem p = problem_for(d);
       const FitResult r = fit_effect(p, EffectParams{}, effect_spec(c.id));
       INFO(c.id << ": fitted " << c.param << " = " << value_of(r, c.param));
@@ -132,7 +132,7 @@ TEST_CASE("a soft steering linkage is fitted inside the cubic map's search range
   // k = -0.75 lies beyond -0.6, where the search used to end (a fit there is only a bound).
   EffectParams truth;
   truth.steer_cubic = -0.75;
-  const DiagData d = prepare(synthesize_open_loop(truth, 11, 30.0), "steer_cubic_soft");
+  const PreparedRecording d = prepare(synthesize_open_loop(truth, 11, 30.0), "steer_cubic_soft");
   const FitResult r = fit_effect(problem_for(d), EffectParams{}, effect_spec("steer_cubic"));
   CHECK(value_of(r, "steer_cubic") == Approx(-0.75).margin(0.1));
   CHECK(value_of(r, "steer_cubic") > effect_spec("steer_cubic").params[0].lo);
@@ -144,7 +144,7 @@ TEST_CASE("recordings that cannot be diagnosed are rejected with the reason", "[
                     Catch::Contains("m.csv") && Catch::Contains("throttle"));
   const sim::Recording short_rec = synthesize_open_loop({}, 1, 2.0);
   CHECK_THROWS_WITH(prepare(short_rec, "short.csv"), Catch::Contains("too short"));
-  const DiagData d = prepare(synthesize_open_loop({}, 1, 10.0), "ok");
+  const PreparedRecording d = prepare(synthesize_open_loop({}, 1, 10.0), "ok");
   CHECK_THROWS_WITH(make_split(d, "abc"), Catch::Contains("--holdout"));
   CHECK_THROWS_AS(make_split(d, "0.99"), Error);
 }
@@ -153,7 +153,7 @@ TEST_CASE("sensor faults written into a clean recording are fitted as sensor fau
   // The faults are applied here to the recorded columns (not by the library's replay): a gyro
   // bias added to the yaw rate, a scale on the velocities, and commands moved 3 rows (60 ms)
   // after the states they produced (states stamped 60 ms early).
-  const DiagData clean = prepare(synthesize_open_loop({}, 11, 30.0), "clean");
+  const PreparedRecording clean = prepare(synthesize_open_loop({}, 11, 30.0), "clean");
   struct Case {
     const char* id;
     const char* param;
@@ -164,7 +164,7 @@ TEST_CASE("sensor faults written into a clean recording are fitted as sensor fau
                         {"time_offset", "time_offset_s", -0.06, 0.012}};
   for (const Case& c : cases) {
     SECTION(c.id) {
-      DiagData d = clean;
+      PreparedRecording d = clean;
       const std::string id = c.id;
       if (id == "gyro_bias")
         for (double& r : d.r) r += 0.05;

@@ -19,7 +19,7 @@ using namespace mppi::diagnose;
 namespace {
 
 // Predictions of `model` on `d` along segments of 25 rows.
-std::vector<double> predictions(const ReplayModel& model, const DiagData& d, std::size_t first_start) {
+std::vector<double> predictions(const ReplayModel& model, const PreparedRecording& d, std::size_t first_start) {
   std::vector<double> all;
   std::vector<double> out(25 * kPredStride);
   for (std::size_t start = first_start; start + 30 < d.rows(); start += 37) {
@@ -32,12 +32,12 @@ std::vector<double> predictions(const ReplayModel& model, const DiagData& d, std
 }  // namespace
 
 TEST_CASE("a pure command delay is replayed as the recorded commands shifted in time", "[diagnose]") {
-  const DiagData d = prepare(synthesize_open_loop({}, 12, 20.0), "drive");
+  const PreparedRecording d = prepare(synthesize_open_loop({}, 12, 20.0), "drive");
   const auto family = make_model_family("single-track");
   const auto plain = family->make({});
   // Shifted by hand: 3 rows (0.06 s) of steering; 2.5 rows (0.05 s) of throttle, which is the
   // average of the commands held 2 and 3 rows before.
-  DiagData shifted = d;
+  PreparedRecording shifted = d;
   for (std::size_t k = 0; k < d.rows(); ++k) {
     shifted.steer[k] = d.steer[k >= 3 ? k - 3 : 0];
     shifted.throttle[k] = 0.5 * (d.throttle[k >= 2 ? k - 2 : 0] + d.throttle[k >= 3 ? k - 3 : 0]);
@@ -115,7 +115,7 @@ sim::Recording throttle_delay_with_a_held_stretch(std::uint64_t seed) {
 // The candidates: the throttle's forms of dynamics and the other longitudinal terms, and the
 // steering's delay and lag; two stability resamples (they judge on the earlier fold too).
 TEST_CASE("an effect the later validation block cannot show is judged on the earlier fold", "[diagnose]") {
-  const DiagData d = prepare(throttle_delay_with_a_held_stretch(5), "held throttle");
+  const PreparedRecording d = prepare(throttle_delay_with_a_held_stretch(5), "held throttle");
   const auto family = make_model_family("single-track");
   DiagnoseOptions o;
   o.plots = false;

@@ -12,7 +12,7 @@
 
 #include "diagnose/diagnose.hpp"
 #include "diagnose/model_family.hpp"
-#include "diagnose/data.hpp"
+#include "sysid/prepared_recording.hpp"
 #include "evidence/generator.hpp"
 #include "evidence/truth_effects.hpp"
 #include "diagnose_fixtures.hpp"

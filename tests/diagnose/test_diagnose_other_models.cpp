@@ -171,7 +171,7 @@ static void check_other_nominal(const char* model, const char* truth_text, doubl
                                 int stability_resamples = SelectionOptions{}.stability_resamples) {
   EffectParams truth;
   const std::vector<std::string> ids = parse_effect_assignments(truth_text, &truth);
-  const DiagData d = prepare(synthesize_open_loop(truth, 41, duration_s, {}, model), std::string(model) + " " + truth_text);
+  const PreparedRecording d = prepare(synthesize_open_loop(truth, 41, duration_s, {}, model), std::string(model) + " " + truth_text);
   DiagnoseOptions o;
   o.plots = false;
   o.selection.candidates = candidates;
@@ -250,7 +250,7 @@ TEST_CASE("models without tyres refuse tyre effects and leave them out of the ca
   CHECK_FALSE(kinematic->supports("friction_change"));
   CHECK(kinematic->supports("steer_delay"));
   CHECK(make_model_family("double-track")->supports("tire_saturation"));
-  const DiagData d = prepare(synthesize_open_loop({}, 42, 20.0, {}, "kinematic"), "kinematic clean");
+  const PreparedRecording d = prepare(synthesize_open_loop({}, 42, 20.0, {}, "kinematic"), "kinematic clean");
   DiagnoseOptions o;
   o.plots = false;
   o.selection.candidates = {"tire_saturation"};

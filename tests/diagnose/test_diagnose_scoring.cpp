@@ -18,7 +18,7 @@ using namespace mppi::diagnose;
 namespace {
 
 struct NoisyAndClean {
-  DiagData noisy, clean;
+  PreparedRecording noisy, clean;
   SensorNoise noise;
 };
 
@@ -65,7 +65,7 @@ TEST_CASE("scoring against noise-free states removes exactly the sensor noise of
 
 TEST_CASE("a reference with other rows is refused", "[diagnose][scoring]") {
   const NoisyAndClean d = drive(EffectParams{}, 32);
-  const DiagData shorter = prepare(synthesize_open_loop(EffectParams{}, 32, 20.0), "shorter");
+  const PreparedRecording shorter = prepare(synthesize_open_loop(EffectParams{}, 32, 20.0), "shorter");
   CHECK_THROWS_AS(horizon_metrics(*make_model_family("single-track")->make({}), d.noisy, {}, {1.0}, 3, {}, &shorter),
                   Error);
 }

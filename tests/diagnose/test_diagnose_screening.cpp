@@ -43,7 +43,7 @@ sim::Recording without_rows(sim::Recording rec, std::size_t first, std::size_t l
   return rec;
 }
 
-FitResult fit_aero_drag(const DiagData& d, std::size_t* segments) {
+FitResult fit_aero_drag(const PreparedRecording& d, std::size_t* segments) {
   static const auto family = make_model_family("single-track");
   FitProblem p;
   p.data = &d;
@@ -69,11 +69,11 @@ TEST_CASE("a 1e30 row and a NaN row are flagged, reported and kept out of the fi
   sysid::write_recording(bad, bad_csv);
 
   // Clean noisy data: nothing flagged.
-  const DiagData clean_d = load_any(clean_csv);
+  const PreparedRecording clean_d = load_any(clean_csv);
   CHECK(clean_d.flags.empty());
   CHECK(clean_d.screened_rows == 0);
 
-  const DiagData bad_d = load_any(bad_csv);
+  const PreparedRecording bad_d = load_any(bad_csv);
   REQUIRE(bad_d.flags.size() == 2);
   CHECK(bad_d.flags[0].file == bad_csv);
   CHECK(bad_d.flags[0].row == kHugeRow);
@@ -91,7 +91,7 @@ TEST_CASE("a 1e30 row and a NaN row are flagged, reported and kept out of the fi
   removed = without_rows(removed, kHugeRow - 1, kHugeRow + 1);
   const std::string removed_csv = temp_path("removed.csv");
   sysid::write_recording(removed, removed_csv);
-  const DiagData removed_d = load_any(removed_csv);
+  const PreparedRecording removed_d = load_any(removed_csv);
   CHECK(removed_d.flags.empty());
 
   std::size_t bad_segments = 0, removed_segments = 0, clean_segments = 0;
@@ -118,7 +118,7 @@ TEST_CASE("the diagnose report lists the screened values", "[diagnose][screen]")
   column(rec, "vy")[500] += 3.0;  // a plausible magnitude, but a single-row spike
   const std::string csv = temp_path("report.csv"), out = temp_path("report");
   sysid::write_recording(rec, csv);
-  const DiagData d = load_any(csv);
+  const PreparedRecording d = load_any(csv);
   REQUIRE(d.flags.size() == 2);
   CHECK(d.flags[1].row == 500);
   CHECK(d.flags[1].column == "vy");
@@ -171,14 +171,14 @@ sim::Recording straight_drive(std::size_t rows, std::size_t respawn, double posi
   return rec;
 }
 
-int pieces(const DiagData& d) { return *std::max_element(d.piece.begin(), d.piece.end()) + 1; }
+int pieces(const PreparedRecording& d) { return *std::max_element(d.piece.begin(), d.piece.end()) + 1; }
 }  // namespace
 
 TEST_CASE("a respawn is cut out at a low sample rate, where its jump is within a row's travel",
           "[diagnose][screen]") {
   // At 20 Hz the 1.04 m jump is less than the 1.25 m that "3 (v + 2) dt + 0.2" allows for any
   // displacement, but not in the direction or at the speed the velocities say.
-  const DiagData d = prepare(straight_drive(400, 200, 0.0, 1), "respawn", 100);
+  const PreparedRecording d = prepare(straight_drive(400, 200, 0.0, 1), "respawn", 100);
   CHECK(pieces(d) == 2);
   CHECK(d.piece[199] == 0);
   CHECK(d.piece[200] == 1);
@@ -188,12 +188,12 @@ TEST_CASE("a respawn is cut out at a low sample rate, where its jump is within a
 TEST_CASE("noisy positions (a GPS fix) are not cut into pieces", "[diagnose][screen]") {
   // 0.2 m of noise per axis: the displacements disagree with the velocities by about 0.3 m
   // every row, which sets the recording's own scale; no row of 2000 is a respawn.
-  const DiagData d = prepare(straight_drive(2000, 2000, 0.2, 7), "gps", 100);
+  const PreparedRecording d = prepare(straight_drive(2000, 2000, 0.2, 7), "gps", 100);
   CHECK(pieces(d) == 1);
   // The same noise with a respawn of 4 m: cut there.
   sim::Recording rec = straight_drive(2000, 1000, 0.2, 7);
   for (std::size_t k = 1000; k < 2000; ++k) rec.data[2][k] += 3.0;
-  const DiagData r = prepare(rec, "gps respawn", 100);
+  const PreparedRecording r = prepare(rec, "gps respawn", 100);
   CHECK(pieces(r) == 2);
   CHECK(r.piece[999] != r.piece[1000]);
 }

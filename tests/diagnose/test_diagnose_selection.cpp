@@ -36,7 +36,7 @@ DiagnoseResult diagnose_synthetic(const std::string& truth_text, std::uint64_t s
                                   double duration_s = 40.0, const SelectionOptions& selection = {}) {
   EffectParams truth;
   *ids = parse_effect_assignments(truth_text, &truth);
-  const DiagData d = prepare(synthesize_open_loop(truth, seed, duration_s), "synthetic " + truth_text);
+  const PreparedRecording d = prepare(synthesize_open_loop(truth, seed, duration_s), "synthetic " + truth_text);
   DiagnoseOptions o;
   o.selection = selection;
   o.out_dir = out_dir;
@@ -168,7 +168,7 @@ TEST_CASE("two hidden effects at once are both named, report and model file agre
   {
     EffectParams truth;
     parse_effect_assignments("steer_delay_s=0.08,throttle_lag_s=0.25", &truth);
-    const DiagData d = prepare(synthesize_open_loop(truth, 31, 20.0), "synthetic");
+    const PreparedRecording d = prepare(synthesize_open_loop(truth, 31, 20.0), "synthetic");
     EvaluateOptions eo;
     eo.rows = f.fitted_on.at("heldout");
     const EvaluateResult e = evaluate_corrected_model(f, "corrected_model.yaml", d, eo);
@@ -280,7 +280,7 @@ TEST_CASE("four hidden effects at once are named in four selection rounds on a s
 }
 
 TEST_CASE("a straight-line recording cannot name steering or grip effects", "[diagnose]") {
-  const DiagData d = prepare(straight_line_drive(5, 40.0), "straight line");
+  const PreparedRecording d = prepare(straight_line_drive(5, 40.0), "straight line");
   DiagnoseOptions o;
   o.plots = false;
   const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track"), o);
@@ -318,7 +318,7 @@ TEST_CASE("a parameter at the end of its search range is a bound, not an estimat
 TEST_CASE("an effect that the held-out part contradicts is not named and no model is written", "[diagnose]") {
   // A gyro bias in the first 70 % of a 20-s recording only: the training part shows it, the
   // held-out part (the last 30 %) does not.
-  DiagData d = prepare(synthesize_open_loop({}, 8, 20.0), "bias that goes away");
+  PreparedRecording d = prepare(synthesize_open_loop({}, 8, 20.0), "bias that goes away");
   const double t_end = d.t.back();
   for (std::size_t k = 0; k < d.rows(); ++k)
     if (d.t[k] < 0.7 * t_end) d.r[k] += 0.08;
@@ -393,7 +393,7 @@ sim::Recording circles_over_patches(std::uint64_t seed, double duration_s,
 }  // namespace
 
 TEST_CASE("a patch of low grip is named as a place, not as a change in time", "[diagnose][slow]") {
-  const DiagData d = prepare(circles_over_patches(11, 60.0, {{8.0, 0.0}}), "circles over a patch");
+  const PreparedRecording d = prepare(circles_over_patches(11, 60.0, {{8.0, 0.0}}), "circles over a patch");
   DiagnoseOptions o;
   o.plots = false;
   const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track"), o);
@@ -421,7 +421,7 @@ TEST_CASE("a patch of low grip is named as a place, not as a change in time", "[
 // The fast case of the one above: 30 s; the candidates: the patch, the change in time, the
 // tyre and a few other terms the turns show; the default stability selection (six resamples).
 TEST_CASE("a patch of low grip on a short recording is named as a place, not as a change in time", "[diagnose]") {
-  const DiagData d = prepare(circles_over_patches(11, 30.0, {{8.0, 0.0}}), "circles over a patch");
+  const PreparedRecording d = prepare(circles_over_patches(11, 30.0, {{8.0, 0.0}}), "circles over a patch");
   DiagnoseOptions o;
   o.plots = false;
   o.selection.candidates = {"grip_patch", "friction_change", "tire_saturation", "payload", "steer_gain", "steer_delay",
@@ -480,7 +480,7 @@ TEST_CASE("simplicity counts only the parameters a fit moved off their default",
 
 TEST_CASE("two patches of one low-grip surface are named as one grip patch with two discs", "[diagnose][slow]") {
   // The same circles with slippery discs on opposite sides of the circle.
-  const DiagData d = prepare(circles_over_patches(12, 40.0, {{8.0, 0.0}, {-8.0, 0.0}}), "circles over two patches");
+  const PreparedRecording d = prepare(circles_over_patches(12, 40.0, {{8.0, 0.0}, {-8.0, 0.0}}), "circles over two patches");
   DiagnoseOptions o;
   o.plots = false;
   const DiagnoseResult r = run_diagnosis(d, *make_model_family("single-track"), o);
@@ -506,7 +506,7 @@ TEST_CASE("two patches of one low-grip surface are named as one grip patch with 
 // The fast case of the one above: 20 s; the candidates of the one-patch fast case, no resamples.
 TEST_CASE("two patches of one low-grip surface on a short recording are named as one grip patch with two discs",
           "[diagnose]") {
-  const DiagData d = prepare(circles_over_patches(12, 20.0, {{8.0, 0.0}, {-8.0, 0.0}}), "circles over two patches");
+  const PreparedRecording d = prepare(circles_over_patches(12, 20.0, {{8.0, 0.0}, {-8.0, 0.0}}), "circles over two patches");
   DiagnoseOptions o;
   o.plots = false;
   o.selection.candidates = {"grip_patch", "friction_change", "tire_saturation", "payload", "steer_gain", "steer_delay",
@@ -537,7 +537,7 @@ TEST_CASE("the parallel selection gives the one-thread result", "[diagnose][slow
   // Oracle: the same diagnosis with oneTBB held to one thread (candidates fitted one at a time).
   EffectParams truth;
   parse_effect_assignments("steer_delay_s=0.08", &truth);
-  const DiagData d = prepare(synthesize_open_loop(truth, 41, 20.0), "steering delay, 20 s");
+  const PreparedRecording d = prepare(synthesize_open_loop(truth, 41, 20.0), "steering delay, 20 s");
   const auto family = make_model_family("single-track");
   const DiagnoseResult parallel = run_diagnosis(d, *family, DiagnoseOptions{});
   DiagnoseResult serial;
@@ -558,7 +558,7 @@ TEST_CASE("the parallel selection gives the one-thread result", "[diagnose][slow
 TEST_CASE("the parallel selection gives the one-thread result on a short recording", "[diagnose]") {
   EffectParams truth;
   parse_effect_assignments("steer_delay_s=0.08", &truth);
-  const DiagData d = prepare(synthesize_open_loop(truth, 41, 10.0), "steering delay, 10 s");
+  const PreparedRecording d = prepare(synthesize_open_loop(truth, 41, 10.0), "steering delay, 10 s");
   const auto family = make_model_family("single-track");
   DiagnoseOptions o;
   o.selection.candidates = {"steer_delay", "steer_lag",  "steer_rate_limit", "steer_backlash",

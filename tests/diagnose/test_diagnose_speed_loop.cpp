@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "base/error.hpp"
-#include "diagnose/data.hpp"
+#include "sysid/prepared_recording.hpp"
 #include "diagnose/diagnose.hpp"
 #include "diagnose/evidence_sweep.hpp"
 #include "diagnose/identifiability.hpp"
@@ -45,12 +45,12 @@ constexpr const char* kLargeLoop = "speed_loop_top_speed_mps=10,speed_loop_kp=0.
 TEST_CASE("only a recording that declares a speed command offers the speed loop", "[diagnose]") {
   const mppi::test::ScratchDir dir("mppi_speed_loop_declared_test");
   const auto rec = mppi::test::independent_recording(dir / "loop.csv", kLargeLoop, 1, "marietta", "ccw", "pursuit");
-  const DiagData declared = load_recording(rec.csv);
+  const PreparedRecording declared = load_recording(rec.csv);
   CHECK(declared.speed_command);
   CHECK(excitation_shortfall(Excitation::kSpeedCommand, measure_excitation(declared, {})).empty());
 
   copy_with_command_line(rec.csv, dir / "undeclared.csv", "");
-  const DiagData undeclared = load_recording((dir / "undeclared.csv").string());
+  const PreparedRecording undeclared = load_recording((dir / "undeclared.csv").string());
   CHECK_FALSE(undeclared.speed_command);
   CHECK_THAT(excitation_shortfall(Excitation::kSpeedCommand, measure_excitation(undeclared, {})),
              Catch::Contains("throttle_command: speed"));

@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "diagnose/data.hpp"
+#include "sysid/prepared_recording.hpp"
 #include "diagnose/diagnose.hpp"
 #include "diagnose/model_family.hpp"
 #include "diagnose/evaluate.hpp"
@@ -29,7 +29,7 @@ sim::Recording steer_delayed_recording() {
 }  // namespace
 
 TEST_CASE("evaluate scores the true effect better than the nominal model and no effect the same", "[diagnose][evaluate]") {
-  const DiagData d = prepare(steer_delayed_recording(), "synthetic steer delay");
+  const PreparedRecording d = prepare(steer_delayed_recording(), "synthetic steer delay");
   CorrectedModelFile with_truth;
   parse_effect_assignments("steer_delay_s=0.1", &with_truth.effects);
   EvaluateOptions o;
@@ -55,7 +55,7 @@ TEST_CASE("evaluate refuses a model and a recording of different cars, naming wh
   rec.metadata["vehicle"] = "dart_jetracer";
   rec.metadata["mass_kg"] = "1.58";
   rec.metadata["wheelbase_m"] = "0.1735";
-  const DiagData small_car = prepare(rec, "dart.csv");
+  const PreparedRecording small_car = prepare(rec, "dart.csv");
   const CorrectedModelFile autorally;  // the library's single-track car: 21.9 kg
   CHECK_THROWS_WITH(check_model_matches_recording(autorally, "m.yaml", small_car),
                     Catch::Contains("mass [kg]") && Catch::Contains("1.58") && Catch::Contains("dart.csv"));
@@ -83,10 +83,10 @@ TEST_CASE("evaluate refuses a model and a recording of different cars, naming wh
 TEST_CASE("evaluate checks the mass and wheelbase each nominal model has", "[diagnose][evaluate]") {
   sim::Recording rec = steer_delayed_recording();
   rec.metadata["mass_kg"] = "1.58";
-  const DiagData light = prepare(rec, "light.csv");
+  const PreparedRecording light = prepare(rec, "light.csv");
   rec.metadata.erase("mass_kg");
   rec.metadata["wheelbase_m"] = "0.1735";
-  const DiagData short_car = prepare(rec, "short.csv");
+  const PreparedRecording short_car = prepare(rec, "short.csv");
   CorrectedModelFile m;
   for (const std::string four_wheel : {models::DoubleTrackModel::kName, models::FullVehicleModel::kName}) {
     m.nominal_model = four_wheel;  // mass and geometry in the single-track core
@@ -114,9 +114,9 @@ TEST_CASE("a corrected-model file keeps its fitted_on section", "[diagnose][eval
 }
 
 TEST_CASE("a part cut off a recording keeps its rows, times and flags", "[diagnose][evaluate]") {
-  const DiagData d = prepare(steer_delayed_recording(), "synthetic");
+  const PreparedRecording d = prepare(steer_delayed_recording(), "synthetic");
   const std::size_t cut = d.rows() * 7 / 10;
-  const DiagData tail = slice_rows(d, cut, d.rows());
+  const PreparedRecording tail = slice_rows(d, cut, d.rows());
   REQUIRE(tail.rows() == d.rows() - cut);
   CHECK(tail.t.front() == d.t[cut]);
   CHECK(tail.vx.back() == d.vx.back());
@@ -128,9 +128,9 @@ TEST_CASE("a part cut off a recording keeps its rows, times and flags", "[diagno
 
 TEST_CASE("a diagnosis scores its correction on test data that neither its fit nor its validation saw",
           "[diagnose][evaluate]") {
-  const DiagData all = prepare(steer_delayed_recording(), "synthetic steer delay");
+  const PreparedRecording all = prepare(steer_delayed_recording(), "synthetic steer delay");
   const std::size_t cut = all.rows() * 7 / 10;
-  const DiagData fit = slice_rows(all, 0, cut), test = slice_rows(all, cut, all.rows());
+  const PreparedRecording fit = slice_rows(all, 0, cut), test = slice_rows(all, cut, all.rows());
   DiagnoseOptions o;
   o.plots = false;
   o.selection.candidates = {"steer_delay", "throttle_lag"};

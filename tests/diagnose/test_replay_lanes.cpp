@@ -24,7 +24,7 @@ namespace {
 // (up to prime_s, inside the start's piece) through the actuator chains, its last wheel_prime_s
 // through the full model with the measured states forced back every row (velocities blended by
 // the observer gain after the first full row), then len rows open loop from the measured state.
-std::vector<double> naive_predict(const ReplayModel& m, const DiagData& d, const Segment& s, const ReplayOptions& o) {
+std::vector<double> naive_predict(const ReplayModel& m, const PreparedRecording& d, const Segment& s, const ReplayOptions& o) {
   float x[ReplayModel::kMaxStates] = {};
   const std::size_t k0 = s.start;
   VehicleState vs;
@@ -78,7 +78,7 @@ std::vector<double> naive_predict(const ReplayModel& m, const DiagData& d, const
 
 // Segments of 25 rows: every 7th row (overlapping), so that runs of lanes, their remainders and
 // the starts just after the piece boundary (short histories: lanes that join their group late) all occur.
-std::vector<Segment> segments_of(const DiagData& d) {
+std::vector<Segment> segments_of(const PreparedRecording& d) {
   std::vector<Segment> segs;
   for (std::size_t k = 0; k + 26 < d.rows(); k += 7)
     if (d.continuous(k, 25)) segs.push_back({k, 25});
@@ -89,7 +89,7 @@ std::vector<Segment> segments_of(const DiagData& d) {
 struct Gap {
   double worst = 0, spread = 0;
 };
-Gap lanes_vs_naive(const ReplayModel& m, const DiagData& d, const std::vector<Segment>& segs) {
+Gap lanes_vs_naive(const ReplayModel& m, const PreparedRecording& d, const std::vector<Segment>& segs) {
   const ReplayOptions o;
   std::vector<double> lanes(segs.size() * 25 * kPredStride);
   predict_segments(m, d, segs, o, lanes.data());
@@ -106,8 +106,8 @@ Gap lanes_vs_naive(const ReplayModel& m, const DiagData& d, const std::vector<Se
 }
 
 // A recording of `model` with a piece boundary at row 300 (a gap, as a respawn leaves).
-DiagData regular_recording(const std::string& model) {
-  DiagData d = prepare(synthesize_open_loop({}, 5, 14.0, {}, model), "drive");
+PreparedRecording regular_recording(const std::string& model) {
+  PreparedRecording d = prepare(synthesize_open_loop({}, 5, 14.0, {}, model), "drive");
   for (std::size_t k = 300; k < d.rows(); ++k)
     if (d.piece[k] >= 0) d.piece[k] += 1;
   return d;
@@ -125,7 +125,7 @@ TEST_CASE("the replay in SIMD lanes predicts what one segment at a time does, fo
     const auto family = make_model_family(model);
     EffectParams with = e;
     if (family->supports("tire_saturation")) with.tyre_peak_scale = 0.8;
-    const DiagData d = regular_recording(model);
+    const PreparedRecording d = regular_recording(model);
     const std::vector<Segment> segs = segments_of(d);
     REQUIRE(segs.size() > 40);
     const auto member = family->make(with);
@@ -137,7 +137,7 @@ TEST_CASE("the replay in SIMD lanes predicts what one segment at a time does, fo
 }
 
 TEST_CASE("the replay in SIMD lanes gives each segment its own start, commands and history", "[diagnose]") {
-  const DiagData d = regular_recording("single-track");
+  const PreparedRecording d = regular_recording("single-track");
   const auto member = make_model_family("single-track")->make({});
   std::vector<Segment> segs = segments_of(d);
   std::vector<double> forward(segs.size() * 25 * kPredStride), backward(forward.size());
@@ -156,7 +156,7 @@ TEST_CASE("the replay in SIMD lanes gives each segment its own start, commands a
 }
 
 TEST_CASE("the replay in SIMD lanes steps a lane across a missing row by its own interval", "[diagnose]") {
-  DiagData d = regular_recording("single-track");
+  PreparedRecording d = regular_recording("single-track");
   // Rows missing from the file: every later time moves on by one interval, inside the piece.
   for (std::size_t missing : {40u, 95u, 96u, 170u, 333u})
     for (std::size_t k = missing; k < d.rows(); ++k) d.t[k] += d.dt_s;
@@ -167,7 +167,7 @@ TEST_CASE("the replay in SIMD lanes steps a lane across a missing row by its own
 }
 
 TEST_CASE("on a recording with timing jitter the lanes share each row's step, and stay close", "[diagnose]") {
-  DiagData d = regular_recording("single-track");
+  PreparedRecording d = regular_recording("single-track");
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> jitter(-0.05, 0.05);  // +-5 % of the sample interval: shared steps
   for (std::size_t k = 1; k < d.rows(); ++k) d.t[k] += jitter(rng) * d.dt_s;

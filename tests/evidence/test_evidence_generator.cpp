@@ -13,7 +13,7 @@
 #include <sstream>
 
 #include "base/error.hpp"
-#include "diagnose/data.hpp"
+#include "sysid/prepared_recording.hpp"
 #include "diagnose/model_family.hpp"
 #include "diagnose/replay.hpp"
 #include "dynamics/vehicle_params.hpp"
@@ -418,7 +418,7 @@ TEST_CASE("evidence: an effect-free recording is predicted by the nominal built 
   const EvidenceResult r = generate_evidence(o, dir + "/clean.csv");
   CHECK(r.vehicle_yaml == o.vehicle_yaml + sim::data_file("config/autorally_single_track.yaml"));
   CHECK(slurp(r.truth_json).find("\"vehicle_params\"") != std::string::npos);
-  const diagnose::DiagData d = diagnose::load_recording(r.clean_csv);
+  const diagnose::PreparedRecording d = diagnose::load_recording(r.clean_csv);
   const std::vector<char> all(d.rows(), 1);
   auto nrmse_1s = [&](const std::string& params) {
     const auto family = diagnose::make_model_family("single-track", params);
@@ -445,16 +445,16 @@ TEST_CASE("evidence: a recording at 25 or 100 Hz is the same drive at that rate"
     o.log_dt_s = log_interval_s(rate_hz);
     return generate_evidence(o, dir + "/" + driver + std::to_string(static_cast<int>(rate_hz)) + ".csv");
   };
-  auto mean_speed = [](const diagnose::DiagData& d) {
+  auto mean_speed = [](const diagnose::PreparedRecording& d) {
     double sum = 0;
     for (std::size_t k = 0; k < d.rows(); ++k) sum += std::hypot(d.vx[k], d.vy[k]);
     return sum / static_cast<double>(d.rows());
   };
   for (const std::string driver : {"pursuit", "human"}) {
-    const diagnose::DiagData at50 = diagnose::load_recording(run(50, driver).clean_csv);
+    const diagnose::PreparedRecording at50 = diagnose::load_recording(run(50, driver).clean_csv);
     for (double rate : {25.0, 100.0}) {
       const EvidenceResult r = run(rate, driver);
-      const diagnose::DiagData d = diagnose::load_recording(r.clean_csv);
+      const diagnose::PreparedRecording d = diagnose::load_recording(r.clean_csv);
       INFO(driver << " at " << rate << " Hz");
       // 20 s of rows, less the 0.1 % the generator drops from the files
       CHECK(d.rows() <= static_cast<std::size_t>(std::lround(20 * rate)));

@@ -7,7 +7,7 @@
 
 #include "chassis/calibration.hpp"
 #include "chassis/priorities.hpp"
-#include "diagnose/data.hpp"
+#include "sysid/prepared_recording.hpp"
 #include "dynamics/corrected_model.hpp"
 #include "sim/recording.hpp"
 #include "error_of.hpp"
@@ -57,6 +57,6 @@ TEST_CASE("diagnosis preparation of a one-row recording is refused, whatever min
   std::istringstream in("t,x,y,yaw,vx,vy,yaw_rate,steer,throttle\n0,0,0,0,1,0,0,0,0.2\n");
   const mppi::sim::Recording rec = mppi::sim::RecordingReader::read(in, "one_row.csv");
   for (std::size_t min_rows : {0, 1, 2})
-    CHECK(contains(error_of([&] { mppi::diagnose::prepare(rec, "one_row.csv", min_rows); }),
+    CHECK(contains(error_of([&] { mppi::sysid::prepare(rec, "one_row.csv", min_rows); }),
                    "one_row.csv: too short for diagnosis: 1 rows, need at least 2"));
 }

@@ -3,7 +3,7 @@
 
     ros_e2e.py laps   --bin BUILD/ros/bin --sim-bin BUILD/bin
                                         mppi_sim_node + mppi_controller_node drive 3 laps of the
-                                        Gazebo oval; checks 0 crashes, the mean lap time within
+                                        Gazebo oval; checks 0 crashes, the median lap time within
                                         5 % of mppi-sim's at the same settings (run here), and the
                                         node's odometry-to-command latency p99 <= 20 ms at 50 Hz
     ros_e2e.py safety --bin BUILD/ros/bin --probe-bin BUILD/bin
@@ -40,6 +40,7 @@ import urllib.error
 import urllib.request
 import signal
 import socket
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -172,10 +173,12 @@ def run_laps(bin_dir, sim_bin, scratch):
     if len(ref_laps) < LAPS:
         failures.append('mppi-sim drove %d of %d laps' % (len(ref_laps), LAPS))
     if ros_laps and ref_laps:
-        ratio = (sum(ros_laps) / len(ros_laps)) / (sum(ref_laps) / len(ref_laps))
-        print('mean lap time ratio ROS / mppi-sim: %.4f' % ratio)
+        # The median lap: the ROS loop runs in wall-clock time, so one lap driven while another
+        # process held both cores (a compile beside the suite) does not decide alone.
+        ratio = statistics.median(ros_laps) / statistics.median(ref_laps)
+        print('median lap time ratio ROS / mppi-sim: %.4f' % ratio)
         if abs(ratio - 1.0) > 0.05:
-            failures.append('mean lap time %.1f %% off mppi-sim\'s (limit 5 %%)' % ((ratio - 1.0) * 100))
+            failures.append('median lap time %.1f %% off mppi-sim\'s (limit 5 %%)' % ((ratio - 1.0) * 100))
     p99 = latency['p99']
     if p99 is None or p99 > 20.0:
         failures.append('latency p99 %s ms > 20 ms' % p99)

@@ -29,6 +29,9 @@ using namespace mppi;
 using namespace mppi::sysid;
 using mppi::test::error_of;
 
+// A scripted recording prepared as calibration and diagnosis read it.
+PreparedRecording prepared(const sim::Recording& rec) { return prepare(rec, "manoeuvres", 3); }
+
 RolloutStep plant_step(const VehicleModelSpec& spec) {
   return [&spec](std::vector<double>& x, const double u[2], double dt) { spec.step(spec.nominal, x.data(), u, dt); };
 }
@@ -126,7 +129,7 @@ TEST_CASE("calibration recovers known drivetrain, brake, steering and tyre param
   o.ff_offset = 0.04;  // the default plant's throttle line (about 20 m/s per unit throttle)
   o.ff_per_mps = 0.05;
   o.extra_state_columns = {"omega_front", "omega_rear"};
-  const sim::Recording rec = roll_out_manoeuvres(plant_step(truth_spec), wheels_rolling(truth, 5.0), o);
+  const PreparedRecording rec = prepared(roll_out_manoeuvres(plant_step(truth_spec), wheels_rolling(truth, 5.0), o));
 
   const VehicleModelSpec start = single_track_spec(SingleTrackParams{}, names);  // 0.38, 10, 1, 0.05, 0.9956
   const std::vector<double> scales = channel_scales(rec, {"vx", "vy", "yaw_rate"});
@@ -152,7 +155,7 @@ TEST_CASE("the shipped calibrated single-track predicts the AutoRally network be
   ManoeuvreOptions o;
   o.duration_s = 40;
   o.seed = 77;  // not a seed the shipped calibration was fitted on (1) or judged on (1001)
-  const sim::Recording rec = roll_out_manoeuvres(network_step(net), std::vector<double>(7, 0.0), o);
+  const PreparedRecording rec = prepared(roll_out_manoeuvres(network_step(net), std::vector<double>(7, 0.0), o));
   const std::vector<std::string> none;
   const VehicleModelSpec old_plant =
       single_track_spec(load_single_track_params(test::data_path("config/autorally_single_track_uncalibrated.yaml")), none);
@@ -223,7 +226,7 @@ TEST_CASE("the shipped calibrated double-track and full vehicle predict the Auto
   ManoeuvreOptions o;
   o.duration_s = 20;
   o.seed = 77;
-  const sim::Recording rec = roll_out_manoeuvres(network_step(net), std::vector<double>(7, 0.0), o);
+  const PreparedRecording rec = prepared(roll_out_manoeuvres(network_step(net), std::vector<double>(7, 0.0), o));
   const std::vector<double> scales = channel_scales(rec, {"vx", "vy", "yaw_rate"});
   const std::vector<std::string> none;
   auto error = [&](const VehicleModelSpec& spec) { return prediction_error(spec, {}, rec, scales).mean_nrmse; };
@@ -245,7 +248,7 @@ TEST_CASE("prediction error and calibration reject bad input by name", "[sysid][
   const VehicleModelSpec spec = single_track_spec(SingleTrackParams{}, {"tyre.D"});
   ManoeuvreOptions o;
   o.duration_s = 5;
-  const sim::Recording rec = roll_out_manoeuvres(plant_step(spec), wheels_rolling(SingleTrackParams{}, 5.0), o);
+  const PreparedRecording rec = prepared(roll_out_manoeuvres(plant_step(spec), wheels_rolling(SingleTrackParams{}, 5.0), o));
   PredictionErrorOptions bad;
   bad.channels = {"vx", "pitch_rate"};
   CHECK_THAT(error_of([&] { prediction_error(spec, spec.nominal, rec, {1.0, 1.0}, bad); }),
@@ -297,9 +300,10 @@ TEST_CASE("the single-track spec's actuator lags: step response, priming from th
       throttle[i] = 0.2;
     }
     std::vector<double> x(11);
-    spec.init_state(rec, 110, x.data());
+    const PreparedRecording stepped = prepared(rec);
+    spec.init_state(stepped, 110, x.data());
     REQUIRE(spec.prime);
-    spec.prime(tau, rec, 110, x.data());
+    spec.prime(tau, stepped, 110, x.data());
     CHECK(x[9] == Approx(0.8 * (1 - std::exp(-0.2 / 0.1))).epsilon(1e-9));  // 10 samples after the step
     CHECK(x[10] == Approx(0.2).epsilon(1e-12));
   }
@@ -363,18 +367,29 @@ TEST_CASE("joined recordings: no rollout spans a seam or starts on one, so a pla
   CHECK(t[251] - t[250] == Approx(t[1] - t[0]));
   CHECK(joined.column("vx")[250] == Approx(b.column("vx")[0]));
 
-  const std::vector<double> scales = channel_scales(joined, {"vx", "vy", "yaw_rate"});
-  const PredictionError e = prediction_error(spec, lag, joined, scales);
-  // Starts every 0.5 s (25 rows) whose 1-s window (50 rows) stays in its piece: rows 0..175 in
-  // the first, 275..425 in the second; none on the seam (row 250) or across it.
-  CHECK(e.rollouts == 8 + 7);
+  const std::vector<double> scales = channel_scales(prepared(joined), {"vx", "vy", "yaw_rate"});
+  const PredictionError e = prediction_error(spec, lag, prepared(joined), scales);
+  // Starts every 0.5 s (25 rows) whose 1-s window (50 rows) stays in its piece, after the piece's
+  // first row (whose previous command is not known): rows 25..175 in the first, 275..425 in the
+  // second; none on the seam (row 250) or across it.
+  CHECK(e.rollouts == 7 + 7);
   CHECK(e.mean_nrmse < 1e-3);
 
-  // The same rows re-timed without the gap: rollouts cross the seam and fail.
+  // The same rows re-timed without the gap: the position jump at the seam still cuts the pieces.
   sim::Recording seamless = joined;
   std::vector<double>& ts = seamless.data[0];
   for (std::size_t i = 0; i < ts.size(); ++i) ts[i] = 0.02 * static_cast<double>(i);
-  CHECK(prediction_error(spec, lag, seamless, scales).mean_nrmse > 0.02);
+  CHECK(prediction_error(spec, lag, prepared(seamless), scales).rollouts == 7 + 7);
+  // With the second piece's path moved to go on from the first one's end as well, nothing marks
+  // the seam: rollouts cross it and fail.
+  for (const char* c : {"x", "y"}) {
+    const auto col = static_cast<std::size_t>(std::find(seamless.columns.begin(), seamless.columns.end(), c) -
+                                              seamless.columns.begin());
+    std::vector<double>& v = seamless.data[col];
+    const double shift = v[249] - v[250];
+    for (std::size_t i = 250; i < v.size(); ++i) v[i] += shift;
+  }
+  CHECK(prediction_error(spec, lag, prepared(seamless), scales).mean_nrmse > 0.02);
 
   CHECK_THAT(error_of([] { join_recordings({}); }), Catch::Contains("no recordings"));
   CHECK_THAT(error_of([&] { join_recordings({a, b}, 0.5); }), Catch::Contains("gap"));

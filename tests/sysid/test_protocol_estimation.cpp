@@ -29,14 +29,14 @@ TEST_CASE("ALM-UKF on the simulated protocol recovers the full vehicle's paramet
   st.process_noise_scale = 0.1;
   st.param_walk_std_per_s = 0.001;
   const VehicleModelSpec fv = full_vehicle_spec(nominal, names);
-  const EstimateResult res = estimate_parameters(fv, run.training, st);
+  const EstimateResult res = estimate_parameters(fv, prepare(run.training, "protocol training", 3), st);
   for (std::size_t i = 0; i < names.size(); ++i) {
     INFO(names[i] << ": " << res.final_values[i] << " (truth " << expected[i] << ", nominal " << fv.nominal[i] << ")");
     CHECK(res.final_values[i] == Approx(expected[i]).epsilon(0.02));
   }
   CHECK(res.rejected_steps == 0);
   // Held-out segment: the estimated model predicts the yaw rate and lateral velocity better.
-  const auto& val = run.validation;
+  const PreparedRecording val = prepare(run.validation, "protocol validation", 3);
   const ValidationResult ve = validate_parameters(fv, res.final_values, val, 0, val.rows(), 1.0);
   const ValidationResult vn = validate_parameters(fv, fv.nominal, val, 0, val.rows(), 1.0);
   for (int c : {0, 1, 4, 5}) {
@@ -82,7 +82,7 @@ std::vector<double> truth_convergence(ProtocolLayout layout, const std::vector<s
   EstimateSettings st;
   st.process_noise_scale = 0.1;
   st.param_walk_std_per_s = 0.001;
-  *result = estimate_parameters(fv, run.training, st);
+  *result = estimate_parameters(fv, prepare(run.training, "protocol training", 3), st);
   std::vector<double> out;
   for (std::size_t i = 0; i < names.size(); ++i)
     out.push_back(convergence_time_to(*result, i, 0.05, (*truth_values)[i]) - result->t.front());

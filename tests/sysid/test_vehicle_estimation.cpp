@@ -52,7 +52,7 @@ TEST_CASE("joint-state UKF and ALM-UKF recover single-track parameters from nois
   const std::vector<std::string> names = {"yaw_inertia_kgm2", "tyre.B", "tyre.D"};
   const VehicleModelSpec spec = single_track_spec(nominal, names);
   const std::vector<double> truth = {1.35, 1.4, 0.85};  // +20%, +21%, -15% from nominal
-  const sim::Recording rec = simulate(spec, truth, 40.0, 5);
+  const PreparedRecording rec = prepare(simulate(spec, truth, 40.0, 5), "simulated driving", 3);
   for (bool adaptive : {false, true}) {
     EstimateSettings st;
     st.adaptive = adaptive;
@@ -70,7 +70,7 @@ TEST_CASE("joint-state UKF and ALM-UKF recover single-track parameters from nois
     CHECK(loaded.mass_kg == nominal.mass_kg);
     // Held-out noise-free data with wheel speeds (rollouts start from exact states): the
     // estimated model predicts far better than the nominal one.
-    const sim::Recording held = simulate(spec, truth, 10.0, 9, 0.0, true);
+    const PreparedRecording held = prepare(simulate(spec, truth, 10.0, 9, 0.0, true), "held-out driving", 3);
     const ValidationResult ve = validate_parameters(spec, res.final_values, held, 0, held.rows(), 1.0);
     const ValidationResult vn = validate_parameters(spec, spec.nominal, held, 0, held.rows(), 1.0);
     CHECK(ve.horizon_rms[5] < 0.3 * vn.horizon_rms[5]);  // yaw rate
@@ -110,7 +110,7 @@ TEST_CASE("estimation rejects unknown parameters and measurements by name", "[sy
   EstimateSettings st;
   st.measure = {"roll_rate"};
   try {
-    estimate_parameters(spec, rec, st);
+    estimate_parameters(spec, prepare(rec, "standing still", 3), st);
     FAIL("no error");
   } catch (const Error& e) {
     CHECK(std::string(e.what()).find("cannot measure 'roll_rate'") != std::string::npos);

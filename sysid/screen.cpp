@@ -1,11 +1,11 @@
-#include "diagnose/screen.hpp"
+#include "sysid/screen.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
 
-namespace mppi::diagnose {
+namespace mppi::sysid {
 
 namespace {
 
@@ -123,4 +123,4 @@ std::vector<char> screened_rows(std::size_t rows, const std::vector<ScreenFlag>&
   return out;
 }
 
-}  // namespace mppi::diagnose
+}  // namespace mppi::sysid

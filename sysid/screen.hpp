@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-namespace mppi::diagnose {
+namespace mppi::sysid {
 
 struct ScreenFlag {
   std::string file;      // the recording (its name in messages)
@@ -51,4 +51,4 @@ std::vector<ScreenFlag> screen_columns(const std::vector<double>& t, const std::
 // Per row: 1 where a flag or the guard around one makes the row unusable.
 std::vector<char> screened_rows(std::size_t rows, const std::vector<ScreenFlag>& flags, int guard_rows);
 
-}  // namespace mppi::diagnose
+}  // namespace mppi::sysid

@@ -1,4 +1,4 @@
-#include "diagnose/data.hpp"
+#include "sysid/prepared_recording.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,12 +6,12 @@
 #include "base/error.hpp"
 #include "sysid/real_data.hpp"
 
-namespace mppi::diagnose {
+namespace mppi::sysid {
 
 namespace {
 
 // The recording's columns and what its metadata says of its command timing and throttle channel.
-void read_columns(const sim::Recording& rec, const std::string& source, DiagData* d) {
+void read_columns(const sim::Recording& rec, const std::string& source, PreparedRecording* d) {
   for (const auto& c : sim::kRecordingRequiredColumns)
     if (!rec.has_column(c)) throw Error(source + ": missing required column '" + c + "'");
   d->t = rec.column("t");
@@ -24,6 +24,8 @@ void read_columns(const sim::Recording& rec, const std::string& source, DiagData
   d->steer = rec.column("steer");
   d->throttle = rec.column("throttle");
   if (rec.has_column("roll")) d->roll = rec.column("roll");
+  for (std::size_t c = 0; c < rec.columns.size(); ++c)
+    if (!d->find_column(rec.columns[c])) d->other_columns[rec.columns[c]] = rec.data[c];
   const auto src = rec.metadata.find("source");
   d->control_lead = (src != rec.metadata.end() &&
                      (src->second == "mppi-sim" || src->second.rfind("mppi-fit synth", 0) == 0))
@@ -45,7 +47,7 @@ double median_interval_s(const std::vector<double>& t) {
 }
 
 // Screens every column (screen.hpp) into d->flags; returns the rows screened out.
-std::vector<char> screen_recording(const std::string& source, const ScreenOptions& screen, DiagData* d) {
+std::vector<char> screen_recording(const std::string& source, const ScreenOptions& screen, PreparedRecording* d) {
   std::vector<ScreenColumn> columns = {{"t", &d->t},   {"x", &d->x},   {"y", &d->y},
                                        {"yaw", &d->yaw}, {"vx", &d->vx}, {"vy", &d->vy},
                                        {"yaw_rate", &d->r}, {"steer", &d->steer}, {"throttle", &d->throttle}};
@@ -56,7 +58,7 @@ std::vector<char> screen_recording(const std::string& source, const ScreenOption
 }
 
 // The displacement from row k - 1 to row k that the measured velocities do not account for [m].
-double unexplained_displacement_m(const DiagData& d, std::size_t k) {
+double unexplained_displacement_m(const PreparedRecording& d, std::size_t k) {
   const double dt = d.t[k] - d.t[k - 1];
   const double c0 = std::cos(d.yaw[k - 1]), s0 = std::sin(d.yaw[k - 1]);
   const double c1 = std::cos(d.yaw[k]), s1 = std::sin(d.yaw[k]);
@@ -66,7 +68,7 @@ double unexplained_displacement_m(const DiagData& d, std::size_t k) {
 }
 
 // A row not screened out, with every required value finite.
-bool row_ok(const DiagData& d, const std::vector<char>& screened, std::size_t k) {
+bool row_ok(const PreparedRecording& d, const std::vector<char>& screened, std::size_t k) {
   const double vals[] = {d.t[k], d.x[k], d.y[k], d.yaw[k], d.vx[k], d.vy[k], d.r[k], d.steer[k], d.throttle[k]};
   bool ok = !screened[k];
   for (double v : vals) ok = ok && std::isfinite(v);
@@ -76,7 +78,7 @@ bool row_ok(const DiagData& d, const std::vector<char>& screened, std::size_t k)
 // The threshold (also the slack of the position-jump rule) scales with the recording's own
 // typical disagreement (position noise, a fused estimate's lag), so that noisy positions do
 // not cut everywhere.
-double teleport_threshold_m(const DiagData& d, const std::vector<char>& screened) {
+double teleport_threshold_m(const PreparedRecording& d, const std::vector<char>& screened) {
   double teleport_m = 0.25;
   std::vector<double> e;
   for (std::size_t k = 1; k < d.t.size(); ++k)
@@ -94,7 +96,7 @@ double teleport_threshold_m(const DiagData& d, const std::vector<char>& screened
 // no car makes, and displacements that the measured velocities do not account for (a respawn or a
 // teleport: at a low sample rate a jump of a track's half width is within what a car covers
 // between two rows, but not in that direction or at that speed).
-std::size_t cut_into_pieces(const std::vector<char>& screened, double teleport_m, DiagData* d) {
+std::size_t cut_into_pieces(const std::vector<char>& screened, double teleport_m, PreparedRecording* d) {
   const std::size_t n = d->t.size();
   d->piece.assign(n, -1);
   int id = -1;
@@ -126,9 +128,26 @@ std::size_t cut_into_pieces(const std::vector<char>& screened, double teleport_m
 
 }  // namespace
 
-DiagData prepare(const sim::Recording& rec, const std::string& source, std::size_t min_rows,
+const std::vector<double>* PreparedRecording::find_column(const std::string& name) const {
+  const std::pair<const char*, const std::vector<double>*> named[] = {
+      {"t", &t},   {"x", &x},   {"y", &y},   {"yaw", &yaw}, {"vx", &vx}, {"vy", &vy}, {"yaw_rate", &r},
+      {"steer", &steer}, {"throttle", &throttle}};
+  for (const auto& [n, v] : named)
+    if (name == n) return v;
+  if (name == "roll") return roll.empty() ? nullptr : &roll;
+  const auto other = other_columns.find(name);
+  return other == other_columns.end() ? nullptr : &other->second;
+}
+
+const std::vector<double>& PreparedRecording::column(const std::string& name) const {
+  const std::vector<double>* v = find_column(name);
+  if (!v) throw Error(source + ": no column '" + name + "'");
+  return *v;
+}
+
+PreparedRecording prepare(const sim::Recording& rec, const std::string& source, std::size_t min_rows,
                  const ScreenOptions& screen) {
-  DiagData d;
+  PreparedRecording d;
   d.source = source;
   d.metadata = rec.metadata;
   read_columns(rec, source, &d);
@@ -148,17 +167,17 @@ DiagData prepare(const sim::Recording& rec, const std::string& source, std::size
   return d;
 }
 
-DiagData load_recording(const std::string& path) {
+PreparedRecording load_recording(const std::string& path) {
   return prepare(sim::RecordingReader::read(path), path);
 }
 
-DiagData concat(const DiagData& a, const DiagData& b) {
+PreparedRecording concat(const PreparedRecording& a, const PreparedRecording& b) {
   if (a.control_lead != b.control_lead)
     throw Error(a.source + " and " + b.source + ": recordings of different kinds (command timing) cannot be combined");
   if (a.speed_command != b.speed_command)
     throw Error(a.source + " and " + b.source + ": one declares its throttle column a speed command "
                 "('# throttle_command: speed'), the other not; they cannot be combined");
-  DiagData d = a;
+  PreparedRecording d = a;
   d.source = a.source + " + " + b.source;
   const double shift = a.t.back() + 10.0 - b.t.front();
   int max_piece = -1;
@@ -177,6 +196,15 @@ DiagData concat(const DiagData& a, const DiagData& b) {
   append(d.throttle, b.throttle, 0);
   if (!a.roll.empty() && !b.roll.empty()) append(d.roll, b.roll, 0);
   else d.roll.clear();  // roll only where both recordings have it
+  for (auto it = d.other_columns.begin(); it != d.other_columns.end();) {  // the same for the others
+    const auto in_b = b.other_columns.find(it->first);
+    if (in_b == b.other_columns.end()) {
+      it = d.other_columns.erase(it);
+    } else {
+      append(it->second, in_b->second, 0);
+      ++it;
+    }
+  }
   for (int p : b.piece) d.piece.push_back(p < 0 ? -1 : p + max_piece + 1);
   for (ScreenFlag f : b.flags) {
     f.row += a.rows();
@@ -186,15 +214,16 @@ DiagData concat(const DiagData& a, const DiagData& b) {
   return d;
 }
 
-DiagData slice_rows(const DiagData& d, std::size_t first, std::size_t last) {
+PreparedRecording slice_rows(const PreparedRecording& d, std::size_t first, std::size_t last) {
   if (!(first < last && last <= d.rows()))
     throw Error(d.source + ": rows " + std::to_string(first) + ".." + std::to_string(last) + " are not a part of its " +
                 std::to_string(d.rows()) + " rows");
-  DiagData s = d;
+  PreparedRecording s = d;
   auto cut = [&](std::vector<double>& v) {
     if (!v.empty()) v = std::vector<double>(v.begin() + static_cast<std::ptrdiff_t>(first), v.begin() + static_cast<std::ptrdiff_t>(last));
   };
   for (auto* v : {&s.t, &s.x, &s.y, &s.yaw, &s.vx, &s.vy, &s.r, &s.steer, &s.throttle, &s.roll}) cut(*v);
+  for (auto& [name, v] : s.other_columns) cut(v);
   s.piece = std::vector<int>(d.piece.begin() + static_cast<std::ptrdiff_t>(first), d.piece.begin() + static_cast<std::ptrdiff_t>(last));
   s.flags.clear();
   s.screened_rows = 0;
@@ -207,11 +236,11 @@ DiagData slice_rows(const DiagData& d, std::size_t first, std::size_t last) {
   return s;
 }
 
-DiagData load_any(const std::string& spec) {
-  return prepare(sysid::load_any_recording(spec), spec);
+PreparedRecording load_any(const std::string& spec) {
+  return prepare(load_any_recording(spec), spec);
 }
 
-Split make_split(const DiagData& d, const std::string& holdout) {
+Split make_split(const PreparedRecording& d, const std::string& holdout) {
   Split s;
   s.heldout.assign(d.rows(), 0);
   const auto colon = holdout.find(':');
@@ -240,4 +269,25 @@ Split make_split(const DiagData& d, const std::string& holdout) {
   return s;
 }
 
-}  // namespace mppi::diagnose
+std::size_t row_at_time(const PreparedRecording& d, double t_s) {
+  return static_cast<std::size_t>(std::lower_bound(d.t.begin(), d.t.end(), t_s) - d.t.begin());
+}
+
+std::vector<Segment> make_segments(const PreparedRecording& d, const std::vector<char>& mask, int len, int stride) {
+  std::vector<Segment> out;
+  const std::size_t n = d.rows();
+  std::size_t k = 0;
+  while (k + static_cast<std::size_t>(len) < n) {
+    bool ok = d.continuous(k, static_cast<std::size_t>(len));
+    for (int i = 0; ok && !mask.empty() && i <= len; ++i) ok = mask[k + static_cast<std::size_t>(i)] != 0;
+    if (ok) {
+      out.push_back({k, len});
+      k += static_cast<std::size_t>(stride);
+    } else {
+      ++k;
+    }
+  }
+  return out;
+}
+
+}  // namespace mppi::sysid
