@@ -1,5 +1,5 @@
-// Recording CSV reader (sim/recording.cpp) and the diagnosis preparation of what it read
-// (diagnose/data.cpp: columns, pieces, sample interval).
+// Recording CSV reader (sim/recording.cpp) and the preparation of what it read
+// (sysid/prepared_recording.cpp: columns, pieces, sample interval).
 #include <sstream>
 
 #include "sysid/prepared_recording.hpp"

@@ -10,7 +10,7 @@
 //   jump        a velocity step no car makes (> max_accel_mps2 between two rows, yaw rate
 //               > max_yaw_accel_radps2) where the position does not jump too (a respawn)
 // Each flag names the row (0-based data row), the column and the value. The flagged rows and
-// `guard_rows` on each side become unusable (prepare() in data.hpp), so no fit segment
+// `guard_rows` on each side become unusable (prepare() in prepared_recording.hpp), so no fit segment
 // contains them and the pieces around them are cut.
 #include <cstddef>
 #include <string>
