@@ -15,6 +15,12 @@ struct ControlLossOptions {
   double max_body_slip_deg = 60.0;
   double min_speed_mps = 1.0;       // below this the slip angle means nothing
   double guard_s = 0.5;             // rows this close to a spin count with it (its onset, its recovery)
+  // The diagnosis leaves these rows out of the selection only where less than this share of the
+  // training rows are lost control (where more are, the spins are most of the data) and what is
+  // left holds at least min_segments_left fit segments: twice the selection's minimum of six
+  // (three to fit, three to validate), so that its folds and resamples still have data.
+  double max_share_left_out = 0.5;
+  int min_segments_left = 12;
 };
 
 // 1 for each row within guard_s of a row whose body slip (folded, so that reversing is not a

@@ -42,7 +42,9 @@ std::string leave_out_control_loss(const PreparedRecording& d, const std::vector
   for (std::size_t k = 0; k < d.rows(); ++k)
     if (lost[k]) (*select_rows)[k] = 0;
   const int len = std::max(2, static_cast<int>(std::lround(o.selection.fit_horizon_s / d.dt_s)));
-  const bool enough = 2 * *lost_training_rows < n_train && make_segments(d, *select_rows, len, len).size() >= 12;
+  const bool enough =
+      static_cast<double>(*lost_training_rows) < o.control_loss.max_share_left_out * static_cast<double>(n_train) &&
+      make_segments(d, *select_rows, len, len).size() >= static_cast<std::size_t>(o.control_loss.min_segments_left);
   char line[320];
   std::snprintf(line, sizeof line,
                 "%zu of %zu training rows (%.1f %%) are lost control "

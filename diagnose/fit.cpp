@@ -89,11 +89,6 @@ std::vector<ParamEstimate> in_spec_order(const EffectSpec& spec, const FitResult
   return out;
 }
 
-// A further disc of the patch's surface is kept only when it lowers the fit cost by this share:
-// the level at which a whole effect counts as seen on validation (SelectionOptions::
-// min_val_improvement), so that a disc is not fitted to noise.
-constexpr double kFurtherDiscGain = 0.03;
-
 }  // namespace
 
 std::vector<ParamSpec> active_params(const EffectSpec& spec, const EffectParams& e) {
@@ -181,7 +176,8 @@ FitResult fit_place_effect(const FitProblem& p, const EffectParams& base, const 
       FitResult r = fit_params(p, starts[s].e, active_params(spec, starts[s].e), 8);
       if (r.cost < more.cost) more = r;
     }
-    if (!(more.cost < (1.0 - kFurtherDiscGain) * best.cost) || !(more.effects.*(disc.radius) > 0.0)) break;
+    // The level at which a whole effect counts as seen, so that a disc is not fitted to noise.
+    if (!(more.cost < (1.0 - p.min_cost_gain) * best.cost) || !(more.effects.*(disc.radius) > 0.0)) break;
     best = more;
   }
   best.params = in_spec_order(spec, best);
@@ -237,11 +233,11 @@ FitResult fit_params(const FitProblem& p, const EffectParams& base, const std::v
   res.cost = fit.cost;
   res.effects = with(fit.params);
   // Uncertainty: s^2 (J^T J)^-1 at the optimum, s^2 inflated by the residual correlation of
-  // multi-step predictions (about one independent sample in five).
+  // multi-step predictions (one independent sample in p.samples_per_independent).
   const std::size_t n = fit.residuals.size();
   Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(np, np);
   if (np > 0 && n > static_cast<std::size_t>(np) && std::isfinite(fit.cost)) {
-    const double s2 = fit.cost * static_cast<double>(n) / static_cast<double>(n - static_cast<std::size_t>(np)) * 5.0;
+    const double s2 = fit.cost * static_cast<double>(n) / static_cast<double>(n - static_cast<std::size_t>(np)) * p.samples_per_independent;
     cov = normal_matrix_at(problem, fit).completeOrthogonalDecomposition().pseudoInverse() * s2;
   }
   for (int i = 0; i < np; ++i) {

@@ -16,6 +16,10 @@
 
 namespace mppi::diagnose {
 
+// Defaults that a fit problem and the selection share (SelectionOptions explains them).
+inline constexpr double kDefaultSamplesPerIndependent = 5.0;
+inline constexpr double kDefaultMinImprovement = 0.03;
+
 // The data a fit works on: segments and channel scales.
 struct FitProblem {
   const PreparedRecording* data = nullptr;
@@ -23,6 +27,12 @@ struct FitProblem {
   std::vector<Segment> segments;
   std::array<double, kChannels> scale{};
   ReplayOptions replay;
+  // Multi-step residuals are correlated: samples per independent one, by which a fit's parameter
+  // covariance is inflated (SelectionOptions::samples_per_independent).
+  double samples_per_independent = kDefaultSamplesPerIndependent;
+  // The cost reduction that counts as seen (SelectionOptions::min_val_improvement): a further disc
+  // of a place-dependent effect is kept only where it lowers the fit cost by this share.
+  double min_cost_gain = kDefaultMinImprovement;
 };
 
 // The family's member with these effects, or nullptr where the values make it invalid.
@@ -72,9 +82,9 @@ struct SelectionOptions {
   double fit_horizon_s = 0.5;       // multi-step horizon of the fit residuals [s]
   // Relative validation-cost reduction an effect must give. The cost includes sensor noise, so
   // a barely visible effect moves it by a few %; 3 % named nothing on 24 effect-free recordings.
-  double min_val_improvement = 0.03;
+  double min_val_improvement = kDefaultMinImprovement;
   double min_bic_drop = 2.0;        // and BIC decrease (effective sample count; 2 = "positive evidence")
-  double samples_per_independent = 5.0;  // residual correlation: samples per independent one
+  double samples_per_independent = kDefaultSamplesPerIndependent;  // residual correlation: samples per independent one
   // Selection rounds at most; each names one candidate, which may be joint (steer_gain+steer_offset,
   // motor_freewheel+drag_brake). A real car can miss several things at once (delays, the ESC's
   // neutral, the weight distribution, the tyre): every round must still pass the gain, BIC and

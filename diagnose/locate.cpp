@@ -107,8 +107,9 @@ struct PlaceCell {
   double x0, x1, y0, y1;
   BinStat stat;
 };
+// The cells of a 4 x 4 grid with at least min_rows rows in mask.
 std::vector<PlaceCell> place_cells(const PreparedRecording& d, const std::vector<double>& resid, const std::vector<char>& mask,
-                                   double spi) {
+                                   double spi, int min_rows) {
   constexpr int kCells = 4;
   double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
   for (std::size_t k = 0; k < resid.size(); ++k)
@@ -133,7 +134,7 @@ std::vector<PlaceCell> place_cells(const PreparedRecording& d, const std::vector
   }
   for (int i = 0; i < kCells; ++i)
     for (int j = 0; j < kCells; ++j) {
-      if (n[i][j] < 50) continue;  // a cell the car barely visited says nothing
+      if (n[i][j] < min_rows) continue;
       PlaceCell c{x0 + i * wx, x0 + (i + 1) * wx, y0 + j * wy, y0 + (j + 1) * wy, {}};
       c.stat.n = n[i][j];
       c.stat.mean = sum[i][j] / n[i][j];
@@ -154,7 +155,9 @@ std::string range_text(const char* name, double lo, double hi, const char* unit)
 }  // namespace
 
 std::vector<Mismatch> locate(const PreparedRecording& d, const ResidualSeries& res, const std::vector<char>& mask,
-                             double min_z, int bins) {
+                             const LocateOptions& options) {
+  const double min_z = options.min_z;
+  const int bins = options.bins;
   std::vector<Mismatch> out;
   const double spi = std::max(1.0, res.horizon_s / d.dt_s);  // overlapping predictions are correlated
   std::vector<std::vector<double>> regimes;
@@ -169,14 +172,14 @@ std::vector<Mismatch> locate(const PreparedRecording& d, const ResidualSeries& r
     // Regime bins that stand out (significant and large against the channel's rms).
     for (int g = 0; g < kRegimes; ++g) {
       for (const auto& b : bin_residual(res.e[c], regimes[static_cast<std::size_t>(g)], mask, bins, spi))
-        if (std::abs(b.z) >= min_z && std::abs(b.mean) >= 0.25 * overall_rms)
+        if (std::abs(b.z) >= min_z && std::abs(b.mean) >= options.min_share_of_rms * overall_rms)
           out.push_back({kChannelNames[c], range_text(kRegimeNames[g], b.lo, b.hi, kRegimeUnits[g]), b.mean,
                          b.rms, b.z, unit});
     }
     // Places: a 4 x 4 grid over the area the masked rows cover; a cell that stands out is where
     // the ground (grip, grade) may differ.
-    for (const PlaceCell& cell : place_cells(d, res.e[c], mask, spi))
-      if (std::abs(cell.stat.z) >= min_z && std::abs(cell.stat.mean) >= 0.25 * overall_rms) {
+    for (const PlaceCell& cell : place_cells(d, res.e[c], mask, spi, options.min_cell_rows))
+      if (std::abs(cell.stat.z) >= min_z && std::abs(cell.stat.mean) >= options.min_share_of_rms * overall_rms) {
         char where[160];
         std::snprintf(where, sizeof where, "place x in [%.3g, %.3g] m, y in [%.3g, %.3g] m", cell.x0, cell.x1, cell.y0,
                       cell.y1);

@@ -44,9 +44,21 @@ struct Mismatch {
   double z = 0;             // how sure: mean / standard error
   std::string unit;
 };
+struct LocateOptions {
+  double min_z = 4.0;  // a finding's mean residual, in standard errors (correlation counted)
+  int bins = 4;        // quantile bins per regime variable
+  // A place cell is judged only with this many rows in it: a cell the car crossed once or twice
+  // (a second at 50 Hz) holds one stretch of correlated residual, not a property of the place.
+  int min_cell_rows = 50;
+  // A regime bin or place stands out only where its mean residual is also this share of the
+  // channel's overall RMS: on a long recording a tiny, physically meaningless bias is
+  // "significant", and a finding should be one worth modelling.
+  double min_share_of_rms = 0.25;
+};
+
 // Findings sorted by |z|, strongest first: per channel the overall bias, the regime bins whose
 // mean residual stands out, and time windows from binary-segmentation change detection.
 std::vector<Mismatch> locate(const PreparedRecording& d, const ResidualSeries& res, const std::vector<char>& mask,
-                             double min_z = 4.0, int bins = 4);
+                             const LocateOptions& options = {});
 
 }  // namespace mppi::diagnose

@@ -24,6 +24,8 @@ void make_problems(const PreparedRecording& d, const ModelFamily& nominal, const
   all.family = fit.family = val.family = &nominal;
   all.replay = fit.replay = val.replay = replay;
   all.scale = fit.scale = val.scale = channel_scales(d, train_mask);
+  all.samples_per_independent = fit.samples_per_independent = val.samples_per_independent = opt.samples_per_independent;
+  all.min_cost_gain = fit.min_cost_gain = val.min_cost_gain = opt.min_val_improvement;
   all.segments = segs;
   // Forward validation: segments are in time order; the last part judges the earlier.
   const std::size_t n_val = std::clamp<std::size_t>(

@@ -78,25 +78,26 @@ bool row_ok(const PreparedRecording& d, const std::vector<char>& screened, std::
 // The threshold (also the slack of the position-jump rule) scales with the recording's own
 // typical disagreement (position noise, a fused estimate's lag), so that noisy positions do
 // not cut everywhere.
-double teleport_threshold_m(const PreparedRecording& d, const std::vector<char>& screened) {
-  double teleport_m = 0.25;
+double teleport_threshold_m(const PreparedRecording& d, const std::vector<char>& screened, const ScreenOptions& o) {
+  double teleport_m = o.min_teleport_m;
   std::vector<double> e;
   for (std::size_t k = 1; k < d.t.size(); ++k)
-    if (row_ok(d, screened, k) && row_ok(d, screened, k - 1) && d.t[k] - d.t[k - 1] <= 3 * d.dt_s)
+    if (row_ok(d, screened, k) && row_ok(d, screened, k - 1) && d.t[k] - d.t[k - 1] <= o.max_gap_intervals * d.dt_s)
       e.push_back(unexplained_displacement_m(d, k));
   if (!e.empty()) {
     std::nth_element(e.begin(), e.begin() + static_cast<std::ptrdiff_t>(e.size() / 2), e.end());
-    teleport_m = std::max(teleport_m, 10.0 * e[e.size() / 2]);
+    teleport_m = std::max(teleport_m, o.teleport_noise_multiple * e[e.size() / 2]);
   }
   return teleport_m;
 }
 
 // Numbers the pieces of d->piece (-1: a row in none) and counts d->screened_rows; returns the
-// usable rows. Pieces: cut at NaN rows, screened rows, gaps > 3 median intervals, position jumps
-// no car makes, and displacements that the measured velocities do not account for (a respawn or a
+// usable rows. Pieces: cut at NaN rows, screened rows, gaps of more than o.max_gap_intervals median
+// intervals, position jumps no car makes, and displacements that the measured velocities do not account for (a respawn or a
 // teleport: at a low sample rate a jump of a track's half width is within what a car covers
 // between two rows, but not in that direction or at that speed).
-std::size_t cut_into_pieces(const std::vector<char>& screened, double teleport_m, PreparedRecording* d) {
+std::size_t cut_into_pieces(const std::vector<char>& screened, double teleport_m, const ScreenOptions& o,
+                            PreparedRecording* d) {
   const std::size_t n = d->t.size();
   d->piece.assign(n, -1);
   int id = -1;
@@ -113,7 +114,8 @@ std::size_t cut_into_pieces(const std::vector<char>& screened, double teleport_m
       const double gap = d->t[k] - d->t[k - 1];
       const double jump = std::hypot(d->x[k] - d->x[k - 1], d->y[k] - d->y[k - 1]);
       const double vmax = std::max(std::abs(d->vx[k]), std::abs(d->vx[k - 1])) + 2.0;
-      if (gap > 3 * d->dt_s || jump > 3 * vmax * gap + teleport_m || unexplained_displacement_m(*d, k) > teleport_m)
+      if (gap > o.max_gap_intervals * d->dt_s || jump > o.max_jump_speed_multiple * vmax * gap + teleport_m ||
+          unexplained_displacement_m(*d, k) > teleport_m)
         open = false;
     }
     if (!open) {
@@ -159,8 +161,8 @@ PreparedRecording prepare(const sim::Recording& rec, const std::string& source, 
   d.dt_s = median_interval_s(d.t);
   if (!(d.dt_s > 0)) throw Error(source + ": cannot determine the sample interval");
   const std::vector<char> screened = screen_recording(source, screen, &d);
-  const double teleport_m = teleport_threshold_m(d, screened);
-  const std::size_t usable = cut_into_pieces(screened, teleport_m, &d);
+  const double teleport_m = teleport_threshold_m(d, screened, screen);
+  const std::size_t usable = cut_into_pieces(screened, teleport_m, screen, &d);
   if (usable < min_rows)
     throw Error(source + ": only " + std::to_string(usable) + " usable rows (no empty fields), need " +
                 std::to_string(min_rows));

@@ -36,6 +36,17 @@ struct ScreenOptions {
   double max_accel_mps2 = 200.0;       // about 20 g
   double max_yaw_accel_radps2 = 1000.0;
   int guard_rows = 1;                  // rows each side of a flagged row dropped with it
+  // Cutting the recording into continuous pieces (prepare()):
+  // - a gap of more than this many median sample intervals (a dropout, a seam);
+  double max_gap_intervals = 3.0;
+  // - a jump in position more than this multiple of what the car covers at its speed (+2 m/s);
+  double max_jump_speed_multiple = 3.0;
+  // - or a displacement that the measured velocities do not account for (a respawn, a teleport)
+  //   by more than the larger of min_teleport_m (a 1:5 car's half length: less is position
+  //   noise) and teleport_noise_multiple x the recording's median disagreement (a noisy or lagging
+  //   position estimate must not cut everywhere).
+  double min_teleport_m = 0.25;
+  double teleport_noise_multiple = 10.0;
 };
 
 // One channel by name (x, y, yaw, vx, vy, yaw_rate, steer, throttle, roll, t) and its values.

@@ -44,7 +44,8 @@ TEST_CASE("a steering play that the resamples split with a lag is named as the s
   const std::string named = mppi::test::joined(r.selection.selected);
   std::string suspected;
   for (const auto& s : r.selection.suspected) suspected += s.id + " (" + s.reason + "); ";
-  INFO("named: " << named << "; suspected: " << suspected << "; held-out reduction " << r.heldout_rmse_reduction);
+  INFO("named: " << named << "; suspected: " << suspected << "; verdict: " << r.selection.verdict
+                  << "; held-out reduction " << r.heldout_rmse_reduction);
   CHECK(contains(r.selection.selected, "steer_backlash"));
   // One form stands for the dynamics; the others are suspected, not named.
   int steer_forms = 0;
