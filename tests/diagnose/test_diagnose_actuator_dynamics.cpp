@@ -36,11 +36,16 @@ TEST_CASE("the effect table groups the forms of each actuator's dynamics", "[dia
 // The independent generator's play between servo and wheels (evidence/: other code than the
 // candidate), driven by its human-like driver, whose smoothed hands rarely reverse the steering
 // sharply: the resamples choose the play in 3 of 6 and a first-order lag in 2. Without the group,
-// neither is stable and nothing is named.
+// neither is stable and nothing is named. (Another resample takes a payload in the play's place,
+// so with the substitutes rule on, the play is reported as ambiguous with it; the rule is off
+// here, and the case below checks what it does.)
 TEST_CASE("a steering play that the resamples split with a lag is named as the steering's dynamics", "[diagnose][slow]") {
   const mppi::test::ScratchDir dir("mppi_actuator_dynamics_test");
-  const DiagnoseResult r = mppi::test::diagnose_independent(
-      mppi::test::independent_recording(dir / "play.csv", "steer_backlash=0.1", 2, "ccrf", "ccw", "human"));
+  DiagnoseOptions without_substitutes;
+  without_substitutes.selection.withhold_substituted = false;
+  const auto recording =
+      mppi::test::independent_recording(dir / "play.csv", "steer_backlash=0.1", 2, "ccrf", "ccw", "human");
+  const DiagnoseResult r = mppi::test::diagnose_independent(recording, without_substitutes);
   const std::string named = mppi::test::joined(r.selection.selected);
   std::string suspected;
   for (const auto& s : r.selection.suspected) suspected += s.id + " (" + s.reason + "); ";
@@ -56,6 +61,15 @@ TEST_CASE("a steering play that the resamples split with a lag is named as the s
   REQUIRE(lag != r.selection.suspected.end());
   CHECK_THAT(lag->reason, Catch::Contains("another form of the steer's dynamics"));
   CHECK(r.heldout_rmse_reduction > 0.3);
+
+  // With the substitutes rule: the play is named, or one of an ambiguous pair and in the correction;
+  // no other steering form and no other physics is named in its place.
+  const DiagnoseResult with_rule = mppi::test::diagnose_independent(recording);
+  INFO("with the substitutes rule: " << with_rule.selection.verdict);
+  const bool named_play = contains(with_rule.selection.selected, "steer_backlash");
+  CHECK((named_play || (contains(with_rule.selection.partial, "steer_backlash") &&
+                        with_rule.selection.ambiguous.find("steer_backlash or ") != std::string::npos)));
+  for (const std::string& id : with_rule.selection.selected) CHECK(id == "steer_backlash");
 }
 
 // The fast case of the one above: 30 s of the same driver and track (another seed), the steering's
