@@ -52,11 +52,20 @@ class RecordingView {
   }
 
  private:
+  // The command `shift_rows` rows before row k's, read inside k's piece: across a gap or an
+  // unusable row (a command not yet recorded, a screened value) the command is not known, and the
+  // piece's nearest one stands for it.
   double shifted(std::size_t k, double shift_rows, double (PreparedRecording::*over)(std::size_t) const) const {
     if (shift_rows == 0.0) return (d_.*over)(k);
     const double pos = static_cast<double>(k) - shift_rows;
     const double lo = std::floor(pos), w = pos - lo;
-    const auto row = [&](double i) { return static_cast<std::size_t>(std::clamp(i, 0.0, static_cast<double>(d_.rows() - 1))); };
+    const int piece = d_.piece[k];
+    const auto row = [&](double i) {
+      auto r = static_cast<std::size_t>(std::clamp(i, 0.0, static_cast<double>(d_.rows() - 1)));
+      while (r < k && d_.piece[r] != piece) ++r;
+      while (r > k && d_.piece[r] != piece) --r;
+      return r;
+    };
     return (1 - w) * (d_.*over)(row(lo)) + w * (d_.*over)(row(lo + 1));
   }
   const PreparedRecording& d_;

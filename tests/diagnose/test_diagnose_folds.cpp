@@ -12,6 +12,7 @@
 #include "diagnose/replay.hpp"
 #include "diagnose/synth.hpp"
 #include "dynamics/single_track.hpp"
+#include "sysid/real_data.hpp"
 
 using namespace mppi;
 using namespace mppi::diagnose;
@@ -61,6 +62,35 @@ TEST_CASE("a pure command delay is replayed as the recorded commands shifted in 
   double moved = 0;
   for (std::size_t i = 0; i < a.size(); ++i) moved = std::max(moved, std::abs(a[i] - c[i]));
   CHECK(moved > 100 * worst);
+}
+
+TEST_CASE("a delayed command is read inside its piece: before the piece it is not known", "[diagnose]") {
+  // The same drive twice: once with its first 40 rows' steering missing (a command not yet
+  // recorded: those rows are in no piece), once cut to start where the piece does. A 0.2-s delay
+  // near the piece's start reaches back before it; in both the piece's first command stands for
+  // the unknown ones, so the predictions agree (and stay finite).
+  const sim::Recording rec = synthesize_open_loop({}, 12, 20.0);
+  sim::Recording missing = rec;
+  const auto steer_col = static_cast<std::size_t>(std::find(rec.columns.begin(), rec.columns.end(), "steer") -
+                                                  rec.columns.begin());
+  for (std::size_t k = 0; k < 40; ++k) missing.data[steer_col][k] = std::nan("");
+  const PreparedRecording with_gap = prepare(missing, "missing");
+  // The piece starts after the missing rows and the screening's guard row.
+  const auto first = static_cast<std::size_t>(
+      std::find_if(with_gap.piece.begin(), with_gap.piece.end(), [](int p) { return p >= 0; }) - with_gap.piece.begin());
+  REQUIRE(first >= 40);
+  REQUIRE(first < 45);
+  const PreparedRecording cut = prepare(sysid::slice_recording(rec, first, rec.rows()), "cut");
+  EffectParams e;
+  e.steer_delay_s = 0.2;
+  const auto delayed = make_model_family("single-track")->make(e);
+  std::vector<double> a(25 * kPredStride), b(25 * kPredStride);
+  predict_segment(*delayed, with_gap, {first + 5, 25}, ReplayOptions{}, a.data());
+  predict_segment(*delayed, cut, {5, 25}, ReplayOptions{}, b.data());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    REQUIRE(std::isfinite(a[i]));
+    CHECK(a[i] == Approx(b[i]).margin(1e-9));
+  }
 }
 
 namespace {
